@@ -1,0 +1,382 @@
+"""Scene configuration: schema, defaults and validation.
+
+A scene is read from YAML (or a dict), checked against the schema below and resolved into a
+`SceneConfig` (pydantic models). Every problem is reported as one `ConfigError` that names the key
+path, the offending value and what is allowed; nothing downstream sees an unchecked value.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union
+
+import yaml
+from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
+                      model_validator)
+
+
+class ConfigError(ValueError):
+    """A scene that cannot be run; the message names the key, the value and what is allowed."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_default=True)
+
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
+Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)]
+
+
+# --- phase functions -------------------------------------------------------------------------
+
+class Isotropic(_Strict):
+    model: Literal["isotropic"]
+
+
+class Rayleigh(_Strict):
+    """Rayleigh-like (3/16 pi)(1 + cos^2)."""
+    model: Literal["rayleigh"]
+
+
+class PureWater(_Strict):
+    """Pure sea water 0.06225 (1 + 0.835 cos^2) (Morel 1974; Mobley 1994, Light and Water)."""
+    model: Literal["pure_water"]
+
+
+class HenyeyGreenstein(_Strict):
+    model: Literal["henyey_greenstein"]
+    g: Asymmetry = 0.9
+
+
+class TwoTermHG(_Strict):
+    """alpha HG(g1) + (1 - alpha) HG(g2)."""
+    model: Literal["two_term_hg"]
+    g1: Asymmetry = 0.95
+    g2: Asymmetry = -0.5
+    alpha: Fraction = 0.95
+
+
+class FournierForand(_Strict):
+    """Fournier-Forand with the backscatter fraction bb/b (Mobley et al. 2002, Appl. Opt. 41)."""
+    model: Literal["fournier_forand"]
+    bb_ratio: Annotated[float, Field(ge=0.0005, le=0.45, allow_inf_nan=False)] = 0.0183
+
+
+class Petzold(_Strict):
+    model: Literal["petzold"]
+
+
+class TablePhase(_Strict):
+    """A user table: a CSV or whitespace file of (scattering angle in deg, phase value) rows."""
+    model: Literal["table"]
+    file: str
+
+
+BasicPhase = Annotated[
+    Union[Isotropic, Rayleigh, PureWater, HenyeyGreenstein, TwoTermHG, FournierForand, Petzold,
+          TablePhase],
+    Field(discriminator="model"),
+]
+
+
+class MixtureComponent(_Strict):
+    b: NonNegative
+    phase: BasicPhase
+
+
+class Mixture(_Strict):
+    """Several scatterers in one layer (e.g. water + particles), weighted by their b (1/m)."""
+    model: Literal["mixture"]
+    components: list[MixtureComponent] = Field(min_length=1, max_length=16)
+
+
+Phase = Annotated[
+    Union[Isotropic, Rayleigh, PureWater, HenyeyGreenstein, TwoTermHG, FournierForand, Petzold,
+          TablePhase, Mixture],
+    Field(discriminator="model"),
+]
+
+
+# --- water -----------------------------------------------------------------------------------
+
+class Layer(_Strict):
+    thickness_m: Annotated[float, Field(gt=0.0)]
+    a: NonNegative
+    b: NonNegative | None = None
+    phase: Phase = Field(default_factory=lambda: Isotropic(model="isotropic"))
+
+    @field_validator("thickness_m")
+    @classmethod
+    def _no_nan(cls, v: float) -> float:
+        if math.isnan(v):
+            raise ValueError("must be a positive number or .inf, got nan")
+        return v
+
+    @model_validator(mode="after")
+    def _scattering(self) -> "Layer":
+        if isinstance(self.phase, Mixture):
+            total = sum(c.b for c in self.phase.components)
+            if self.b is None:
+                self.b = total
+            elif not math.isclose(self.b, total, rel_tol=1e-9, abs_tol=1e-12):
+                raise ValueError(f"b = {self.b} differs from the sum of the mixture's component b "
+                                 f"({total}); give one or make them agree")
+        elif self.b is None:
+            raise ValueError("b (scattering coefficient, 1/m) is required")
+        return self
+
+
+class Water(_Strict):
+    layers: list[Layer] = Field(min_length=1, max_length=100_000)
+
+    @model_validator(mode="after")
+    def _infinite_last_only(self) -> "Water":
+        for i, layer in enumerate(self.layers):
+            if math.isinf(layer.thickness_m):
+                if i != len(self.layers) - 1:
+                    raise ValueError(f"layers[{i}].thickness_m = .inf: only the last layer may be "
+                                     "infinitely deep")
+                if layer.a == 0.0 and layer.b > 0.0:
+                    raise ValueError(f"layers[{i}]: an infinitely deep layer that scatters (b > 0) "
+                                     "needs a > 0, or photons never leave it")
+        return self
+
+    @property
+    def depth_m(self) -> float:
+        return float(sum(layer.thickness_m for layer in self.layers))
+
+
+# --- illumination, surface, bottom -----------------------------------------------------------
+
+class Illumination(_Strict):
+    Ed0: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1.0
+    sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
+    diffuse_fraction: Fraction = 0.0
+    sky: Literal["uniform", "cardioidal"] = "uniform"
+
+
+class Surface(_Strict):
+    model: Literal["flat", "none"] = "flat"
+    n_water: Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.34
+
+
+class NoBottom(_Strict):
+    model: Literal["none"]
+
+
+class BlackBottom(_Strict):
+    model: Literal["black"]
+
+
+class LambertianBottom(_Strict):
+    model: Literal["lambertian"]
+    reflectance: Fraction
+
+
+class MinnaertBottom(_Strict):
+    """(rho/pi)(cos t_i cos t_r)^k; rho_dh = 2 rho cos^k(t_i)/(k + 2) <= 1 for k >= 0."""
+    model: Literal["minnaert"]
+    reflectance: Fraction
+    k: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)]
+
+
+class SpecularBottom(_Strict):
+    model: Literal["specular"]
+    reflectance: Fraction
+
+
+Bottom = Annotated[
+    Union[NoBottom, BlackBottom, LambertianBottom, MinnaertBottom, SpecularBottom],
+    Field(discriminator="model"),
+]
+
+
+# --- tallies and estimator -------------------------------------------------------------------
+
+HYDROLIGHT_THETA_EDGES_DEG = (0.0, 5.0, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0, 90.0,
+                              95.0, 105.0, 115.0, 125.0, 135.0, 145.0, 155.0, 165.0, 175.0, 180.0)
+
+
+class Tallies(_Strict):
+    depths_m: list[NonNegative] = Field(default_factory=lambda: [0.0], max_length=10_000)
+    theta_edges_deg: Literal["hydrolight"] | list[Finite] = "hydrolight"
+    phi_bands: Annotated[int, Field(ge=1, le=360)] = 24
+    radiance: bool = True
+    grazing_mu_cut: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 0.01
+
+    @field_validator("depths_m")
+    @classmethod
+    def _sorted_unique(cls, v: list[float]) -> list[float]:
+        return sorted(set(v))
+
+    @field_validator("theta_edges_deg")
+    @classmethod
+    def _edges(cls, v):
+        if v == "hydrolight":
+            return v
+        if len(v) < 2 or v[0] != 0.0 or v[-1] != 180.0:
+            raise ValueError(f"must start at 0 and end at 180 (deg), got {v}")
+        if any(b <= a for a, b in zip(v, v[1:])):
+            raise ValueError(f"must increase strictly, got {v}")
+        if 90.0 not in v:
+            raise ValueError(f"must include 90 so that no band straddles the horizontal, got {v}")
+        return v
+
+    @property
+    def theta_edges(self) -> tuple[float, ...]:
+        if self.theta_edges_deg == "hydrolight":
+            return HYDROLIGHT_THETA_EDGES_DEG
+        return tuple(self.theta_edges_deg)
+
+
+class Estimator(_Strict):
+    """How photon weights evolve. `implicit`: absorption and Fresnel splitting by weight, with
+    Russian roulette below `roulette_weight` (survivors get weight / roulette_survival).
+    `analog`: absorption, Fresnel and bottom reflection decided by random draws (for tests)."""
+    mode: Literal["implicit", "analog"] = "implicit"
+    roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
+    roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
+    max_events: Annotated[int, Field(ge=100)] = 1_000_000
+
+
+class SceneConfig(_Strict):
+    name: str = "oceanmc scene"
+    photons: Annotated[int, Field(gt=0, le=10**13)] = 1_000_000
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 1
+    batches: Annotated[int, Field(ge=2, le=100_000)] = 32
+    illumination: Illumination = Field(default_factory=Illumination)
+    surface: Surface = Field(default_factory=Surface)
+    water: Water
+    bottom: Bottom
+    tallies: Tallies = Field(default_factory=Tallies)
+    estimator: Estimator = Field(default_factory=Estimator)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "SceneConfig":
+        deep = math.isinf(self.water.layers[-1].thickness_m)
+        if deep and self.bottom.model != "none":
+            raise ValueError(f"bottom.model = {self.bottom.model!r} below an infinitely deep last "
+                             "layer: use bottom.model = 'none'")
+        if not deep and self.bottom.model == "none":
+            raise ValueError("bottom.model = 'none' needs an infinitely deep last layer "
+                             "(thickness_m: .inf); a finite water column needs a bottom "
+                             "(black, lambertian, minnaert, specular)")
+        depth = self.water.depth_m
+        for d in self.tallies.depths_m:
+            if d > depth:
+                raise ValueError(f"tallies.depths_m contains {d} m, below the bottom at "
+                                 f"{depth} m; allowed: 0 <= depth <= {depth}")
+        if self.photons < self.batches:
+            raise ValueError(f"photons = {self.photons} is fewer than batches = {self.batches}")
+        return self
+
+    @property
+    def n_water(self) -> float:
+        return self.surface.n_water if self.surface.model == "flat" else 1.0
+
+
+# --- loading ---------------------------------------------------------------------------------
+
+def _key_path(loc: tuple) -> str:
+    path = ""
+    for part in loc:
+        if isinstance(part, int):
+            path += f"[{part}]"
+        elif part in {"isotropic", "rayleigh", "pure_water", "henyey_greenstein", "two_term_hg",
+                      "fournier_forand", "petzold", "table", "mixture", "none", "black",
+                      "lambertian", "minnaert", "specular"} or str(part).startswith(("list[",
+                                                                                      "literal[")):
+            continue  # pydantic's union-branch tags are not keys the user wrote
+        else:
+            path += ("." if path else "") + str(part)
+    return path or "(top level)"
+
+
+def _describe(error: dict) -> str:
+    path = _key_path(tuple(error.get("loc", ())))
+    kind = error.get("type", "")
+    msg = error.get("msg", "invalid")
+    if msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    if kind == "extra_forbidden":
+        return f"{path}: unknown key (check its spelling and level)"
+    if kind == "missing":
+        return f"{path}: required key is missing"
+    if "input" in error and kind not in ("model_type", "dict_type"):
+        value = error["input"]
+        shown = repr(value)
+        if len(shown) > 80:
+            shown = shown[:77] + "..."
+        if isinstance(value, dict):
+            return f"{path}: {msg}"
+        return f"{path} = {shown}: {msg}"
+    return f"{path}: {msg}"
+
+
+def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] | None = None
+                ) -> SceneConfig:
+    """Reads a scene from a YAML file path or a dict, applies top-level overrides (photons, seed),
+    and returns the validated SceneConfig. Raises ConfigError with one clear message."""
+    origin = "config"
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        origin = str(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ConfigError(f"{origin}: no such file") from None
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ConfigError(f"{origin}: cannot read it ({exc})") from None
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"{origin}: not valid YAML ({str(exc).splitlines()[0]} "
+                              f"{getattr(exc, 'problem_mark', '') or ''})".strip()) from None
+        except RecursionError:
+            raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
+        base_dir = path.parent
+    elif isinstance(source, dict):
+        data = source
+        base_dir = Path.cwd()
+    else:
+        raise ConfigError(f"{origin}: expected a YAML file path or a mapping, got "
+                          f"{type(source).__name__}")
+    if data is None:
+        raise ConfigError(f"{origin}: the file is empty; a scene needs at least water and bottom")
+    if not isinstance(data, dict):
+        raise ConfigError(f"{origin}: the top level must be a mapping of keys (name, photons, "
+                          f"water, bottom, ...), got {type(data).__name__}")
+    data = dict(data)
+    for key, value in (overrides or {}).items():
+        if value is not None:
+            data[key] = value
+    try:
+        config = SceneConfig.model_validate(data)
+    except ValidationError as exc:
+        errors = exc.errors()
+        first = _describe(errors[0])
+        more = f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})" \
+            if len(errors) > 1 else ""
+        raise ConfigError(f"{origin}: {first}{more}") from None
+    except RecursionError:
+        raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
+    _resolve_files(config, base_dir, origin)
+    return config
+
+
+def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
+    """Table files are relative to the config file's folder; they are checked when the scene is
+    built (scene.py), which reports the file and the problem."""
+    for layer in config.water.layers:
+        phases = [c.phase for c in layer.phase.components] \
+            if isinstance(layer.phase, Mixture) else [layer.phase]
+        for phase in phases:
+            if isinstance(phase, TablePhase):
+                phase.file = str((base_dir / phase.file).resolve())
+
+
+def config_to_yaml(config: SceneConfig) -> str:
+    """The full resolved scene (defaults filled in) as YAML text; load_config reads it back."""
+    return yaml.safe_dump(config.model_dump(), sort_keys=False, allow_unicode=True)

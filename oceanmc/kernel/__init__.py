@@ -1,0 +1,36 @@
+"""The compiled world: @njit functions over plain arrays, integer model ids and floats only.
+
+Nothing here imports the Python side (config, results); scene.py packs a SceneArrays for it.
+Everything is importable and testable with NUMBA_DISABLE_JIT=1.
+
+Numba's on-disk cache checks only the source file of each cached function, not the files of the
+functions it calls, so an edit to (say) tally.py would leave transport's cached machine code
+stale. The cache therefore lives in a folder named after a hash of every kernel source file:
+any kernel edit starts a fresh cache. Numba reads CACHE_DIR when a function is decorated, so it
+is set only while the kernel modules load and restored afterwards.
+"""
+import hashlib
+from pathlib import Path
+
+import numba
+
+
+def _kernel_hash() -> str:
+    digest = hashlib.sha256(numba.__version__.encode())
+    root = Path(__file__).parent
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+CACHE_DIR = Path(__file__).parent / "__pycache__" / f"numba-{_kernel_hash()}"
+
+_previous = numba.config.CACHE_DIR
+numba.config.CACHE_DIR = str(CACHE_DIR)
+try:
+    from . import driver  # noqa: E402,F401  (imports every kernel module)
+    from .brdf import dispatch as _brdf  # noqa: E402,F401
+    from .phase import dispatch as _phase  # noqa: E402,F401
+finally:
+    numba.config.CACHE_DIR = _previous

@@ -1,0 +1,35 @@
+"""The flat air-water interface: exact unpolarized Fresnel reflectance and Snell refraction."""
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def fresnel(n1, n2, cos_i):
+    """(R, cos_t) for light going from index n1 into n2 at incidence cosine cos_i >= 0.
+    R = (Rs + Rp)/2 (Born & Wolf, Principles of Optics, 1.5.3); total internal reflection gives
+    (1, 0). Normal incidence gives ((n1 - n2)/(n1 + n2))^2."""
+    if n1 == n2:
+        return 0.0, cos_i
+    sin_t2 = (n1 / n2) ** 2 * max(0.0, 1.0 - cos_i * cos_i)
+    if sin_t2 >= 1.0:
+        return 1.0, 0.0
+    cos_t = math.sqrt(1.0 - sin_t2)
+    den_s = n1 * cos_i + n2 * cos_t
+    den_p = n1 * cos_t + n2 * cos_i
+    if den_s == 0.0 or den_p == 0.0:   # grazing incidence from the less dense side
+        return 1.0, cos_t
+    rs = (n1 * cos_i - n2 * cos_t) / den_s
+    rp = (n1 * cos_t - n2 * cos_i) / den_p
+    return 0.5 * (rs * rs + rp * rp), cos_t
+
+
+@njit(cache=True)
+def refract(ux, uy, uz, ratio, cos_t):
+    """Direction after crossing a horizontal interface: tangential components scale by
+    ratio = n1/n2 (Snell), the vertical one keeps its sign with magnitude cos_t."""
+    nx = ux * ratio
+    ny = uy * ratio
+    nz = cos_t if uz > 0.0 else -cos_t
+    norm = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+    return nx * norm, ny * norm, nz * norm

@@ -1,0 +1,13 @@
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def sample(params, u):
+    return 2.0 * u - 1.0
+
+
+@njit(cache=True)
+def evaluate(params, cos_psi):
+    return 1.0 / (4.0 * math.pi)

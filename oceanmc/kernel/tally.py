@@ -1,0 +1,77 @@
+"""Plane-crossing tallies: a photon of weight w crossing a level with direction cosine mu adds w
+to Ed or Eu, w/|mu| to Eod or Eou and to the radiance of its quad (normalised by the quad's solid
+angle and the photon count later, in results.py). Grazing crossings use the surface-flux rule:
+1/|mu| is replaced by 2/mu_cut when |mu| < mu_cut, which is exact when the radiance is constant
+over |mu| < mu_cut and keeps the variance finite (MCNP manual, F2 surface flux tally)."""
+import math
+
+from numba import njit
+
+from .models import AIR_ED, AIR_EU, AIR_EU_WATER_LEAVING, FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
+
+
+@njit(cache=True)
+def theta_band(uz, mu_edges):
+    """Index i with mu_edges[i] >= uz > mu_edges[i + 1] (mu_edges falls from 1 to -1)."""
+    lo = 0
+    hi = mu_edges.shape[0] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if uz <= mu_edges[mid]:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+@njit(cache=True)
+def phi_band(ux, uy, n_phi):
+    """Band index with band 0 centred on phi = 0 (the sun's travel azimuth)."""
+    phi = math.atan2(uy, ux)
+    k = int(math.floor(phi * n_phi / (2.0 * math.pi) + 0.5))
+    return k % n_phi
+
+
+@njit(cache=True)
+def inverse_mu(uz, mu_cut):
+    amu = abs(uz)
+    return 1.0 / amu if amu >= mu_cut else 2.0 / mu_cut
+
+
+@njit(cache=True)
+def score_radiance(sc, grid, w_over_mu, ux, uy, uz):
+    band = theta_band(uz, sc.theta_mu_edges)
+    col = 0 if sc.theta_is_cap[band] else phi_band(ux, uy, sc.n_phi)
+    grid[band, col] += w_over_mu
+
+
+@njit(cache=True)
+def score_water(sc, flux, radiance, level, w, ux, uy, uz):
+    w_over_mu = w * inverse_mu(uz, sc.mu_cut)
+    if uz > 0.0:
+        flux[level, FLUX_ED] += w
+        flux[level, FLUX_EOD] += w_over_mu
+    else:
+        flux[level, FLUX_EU] += w
+        flux[level, FLUX_EOU] += w_over_mu
+    if sc.tally_radiance:
+        score_radiance(sc, radiance[level], w_over_mu, ux, uy, uz)
+
+
+@njit(cache=True)
+def score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz):
+    air_flux[AIR_ED] += w
+    if sc.tally_radiance:
+        score_radiance(sc, air_radiance, w * inverse_mu(uz, sc.mu_cut), ux, uy, uz)
+
+
+@njit(cache=True)
+def score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, water_leaving):
+    air_flux[AIR_EU] += w
+    if water_leaving:
+        air_flux[AIR_EU_WATER_LEAVING] += w
+    if sc.tally_radiance:
+        w_over_mu = w * inverse_mu(uz, sc.mu_cut)
+        score_radiance(sc, air_radiance, w_over_mu, ux, uy, uz)
+        if water_leaving:
+            score_radiance(sc, air_lw, w_over_mu, ux, uy, uz)

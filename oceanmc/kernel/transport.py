@@ -1,0 +1,208 @@
+"""The photon loop: weighted photon packets from the sun and sky, through the surface, the layered
+water and off the bottom, until they leave, are absorbed or lose Russian roulette.
+
+Estimator (sc.analog False, the default): implicit capture (a collision keeps the packet and
+multiplies its weight by the single-scattering albedo), expected-value splitting at the surface
+(the reflected part w R and the transmitted part w (1 - R) are both followed or tallied: the one
+that leaves the water is scored and ends, the other goes on) and at the bottom (weight times
+rho_dh), exact exponential attenuation in layers that do not scatter, and unbiased Russian
+roulette below sc.roulette_weight. Analog mode decides each of these with a random draw instead.
+Either way every quantity has the same expectation; only the variance differs.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from .brdf import dispatch as brdf
+from .geometry import from_angles, turn
+from .interface import fresnel, refract
+from .models import (BOTTOM_BLACK, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
+                     BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
+from .phase import dispatch as phase
+from .sources import sky_cosine
+from .tally import score_air_down, score_air_up, score_water
+
+TWO_PI = 2.0 * math.pi
+
+
+@njit(cache=True)
+def exponential():
+    return -math.log(1.0 - np.random.random())
+
+
+@njit(cache=True)
+def survives_roulette(sc, w):
+    """(alive, new weight): below the threshold a packet survives with probability p and then
+    carries w/p, so the expected weight is unchanged."""
+    if sc.analog or w >= sc.roulette_weight:
+        return True, w
+    if np.random.random() < sc.roulette_survival:
+        return True, w / sc.roulette_survival
+    return False, 0.0
+
+
+@njit(cache=True)
+def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_lw, budget):
+    """Follows one packet that arrives at the surface from the air; returns its scattering count."""
+    score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz)
+    n = sc.n_water
+    if sc.surface_flat:
+        r, cos_t = fresnel(1.0, n, uz)
+        if sc.analog:
+            if np.random.random() < r:
+                score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, -uz, False)
+                budget[BUDGET_SURFACE_REFLECTION] += w
+                return 0
+        else:
+            if r > 0.0:
+                score_air_up(sc, air_flux, air_radiance, air_lw, w * r, ux, uy, -uz, False)
+                budget[BUDGET_SURFACE_REFLECTION] += w * r
+            w *= 1.0 - r
+        ux, uy, uz = refract(ux, uy, uz, 1.0 / n, cos_t)
+    if sc.surface_tally >= 0:
+        score_water(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz)
+
+    plane_z = sc.plane_z
+    bottom_plane = plane_z.shape[0] - 1
+    z = 0.0
+    seg = 0
+    tau = exponential()
+    events = 0
+    while True:
+        if w <= 0.0:
+            return events
+        layer = sc.segment_layer[seg]
+        a = sc.layer_a[layer]
+        b = sc.layer_b[layer]
+        if uz > 0.0:
+            target = seg + 1
+            dist = (plane_z[target] - z) / uz
+        elif uz < 0.0:
+            target = seg
+            dist = (plane_z[target] - z) / uz
+        else:
+            target = -1
+            dist = math.inf
+        if b > 0.0:
+            c = a + b
+            s = tau / c
+            if s < dist:
+                z += s * uz
+                events += 1
+                if sc.analog:
+                    if np.random.random() * c < a:
+                        budget[BUDGET_LAYERS + layer] += w
+                        return events
+                else:
+                    absorbed = w * (a / c)
+                    budget[BUDGET_LAYERS + layer] += absorbed
+                    w -= absorbed
+                cos_s = phase.sample_cos(sc, layer, np.random.random(), np.random.random())
+                ux, uy, uz = turn(ux, uy, uz, cos_s, TWO_PI * np.random.random())
+                tau = exponential()
+                alive, w = survives_roulette(sc, w)
+                if not alive:
+                    return events
+                if events >= sc.max_events:
+                    budget[BUDGET_TRUNCATED] += w
+                    return events
+                continue
+            tau -= dist * c
+        elif dist == math.inf:
+            # no scattering and no plane ahead: down an infinitely deep clear layer, or level
+            budget[(BUDGET_LAYERS + layer) if a > 0.0 else BUDGET_LOST_BELOW] += w
+            return events
+        elif a > 0.0:
+            transmitted = math.exp(-a * dist)
+            if sc.analog:
+                if np.random.random() >= transmitted:
+                    budget[BUDGET_LAYERS + layer] += w
+                    return events
+            else:
+                budget[BUDGET_LAYERS + layer] += w * (1.0 - transmitted)
+                w *= transmitted
+        if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
+            budget[BUDGET_LOST_BELOW] += w
+            return events
+
+        z = plane_z[target]
+        level = sc.plane_tally[target]
+        if level >= 0:
+            score_water(sc, flux, radiance, level, w, ux, uy, uz)
+
+        if target == 0:
+            # at the surface from below
+            if not sc.surface_flat:
+                score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, True)
+                budget[BUDGET_WATER_LEAVING] += w
+                return events
+            r, cos_t = fresnel(n, 1.0, -uz)
+            if sc.analog:
+                if np.random.random() >= r:
+                    ox, oy, oz = refract(ux, uy, uz, n, cos_t)
+                    score_air_up(sc, air_flux, air_radiance, air_lw, w, ox, oy, oz, True)
+                    budget[BUDGET_WATER_LEAVING] += w
+                    return events
+            else:
+                leaving = w * (1.0 - r)
+                if leaving > 0.0:
+                    ox, oy, oz = refract(ux, uy, uz, n, cos_t)
+                    score_air_up(sc, air_flux, air_radiance, air_lw, leaving, ox, oy, oz, True)
+                    budget[BUDGET_WATER_LEAVING] += leaving
+                w *= r
+            uz = -uz
+            seg = 0
+            if level >= 0 and w > 0.0:
+                score_water(sc, flux, radiance, level, w, ux, uy, uz)
+        elif target == bottom_plane:
+            if sc.bottom_model == BOTTOM_BLACK:
+                budget[BUDGET_BOTTOM] += w
+                return events
+            ux, uy, uz, rho = brdf.reflect(sc.bottom_model, sc.bottom_params, ux, uy, uz,
+                                           np.random.random(), np.random.random())
+            if sc.analog:
+                if np.random.random() >= rho:
+                    budget[BUDGET_BOTTOM] += w
+                    return events
+            else:
+                budget[BUDGET_BOTTOM] += w * (1.0 - rho)
+                w *= rho
+            seg = bottom_plane - 1
+            if level >= 0 and w > 0.0:
+                score_water(sc, flux, radiance, level, w, ux, uy, uz)
+        else:
+            seg = target if uz > 0.0 else target - 1
+            continue
+        alive, w = survives_roulette(sc, w)
+        if not alive:
+            return events
+
+
+@njit(cache=True)
+def trace_batch(sc, n_photons, seed, flux, radiance, air_flux, air_radiance, air_lw, budget):
+    """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
+    packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
+    come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
+    scattering events."""
+    np.random.seed(seed)
+    f = sc.diffuse_fraction
+    if f <= 0.0:
+        n_sky = 0
+    elif f >= 1.0:
+        n_sky = n_photons
+    else:
+        n_sky = min(n_photons - 1, max(1, int(round(f * n_photons))))
+    w_sky = f * n_photons / n_sky if n_sky > 0 else 0.0
+    w_sun = (1.0 - f) * n_photons / (n_photons - n_sky) if n_sky < n_photons else 0.0
+    events = 0
+    for i in range(n_photons):
+        if i < n_sky:
+            ux, uy, uz = from_angles(sky_cosine(sc.sky_model), TWO_PI * np.random.random())
+            w = w_sky
+        else:
+            ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
+            w = w_sun
+        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance,
+                               air_lw, budget)
+    return events

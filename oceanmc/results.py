@@ -1,0 +1,243 @@
+"""Result: per-batch tallies turned into means and standard errors, and their HDF5 form.
+
+Every quantity keeps its per-batch values (leading `batch` axis); the estimate is the mean over
+batches and its standard error the sample standard deviation over sqrt(batches). Because the
+batch values are stored, results of independent runs merge by concatenating batches.
+"""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from .kernel import models
+
+FORMAT_VERSION = 1
+
+
+@dataclass
+class Quantity:
+    name: str                 # path in the file: "Ed", "air/Lw", "budget/water_leaving"
+    dims: tuple[str, ...]     # dimensions of the estimate (without the batch axis)
+    batches: np.ndarray       # (batch, *dims)
+    units: str
+    description: str
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.batches.mean(axis=0)
+
+    @property
+    def stderr(self) -> np.ndarray:
+        n = self.batches.shape[0]
+        return self.batches.std(axis=0, ddof=1) / math.sqrt(n)
+
+
+@dataclass
+class Result:
+    coords: dict[str, np.ndarray]
+    quantities: dict[str, Quantity]
+    attrs: dict[str, object] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.quantities[name].mean
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.quantities
+
+    def stderr(self, name: str) -> np.ndarray:
+        return self.quantities[name].stderr
+
+    @property
+    def config_yaml(self) -> str:
+        return str(self.attrs["config_yaml"])
+
+    def save(self, path: str | Path) -> Path:
+        return save_result(self, path)
+
+
+# --- building a Result from raw kernel tallies ------------------------------------------------
+
+RAD_UNITS = "W m-2 sr-1 (per unit Ed0)"
+IRR_UNITS = "W m-2 (per unit Ed0)"
+
+
+def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
+    terms = [
+        (models.BUDGET_SURFACE_REFLECTION, "surface_reflection",
+         "fraction of Ed(0+) reflected by the surface (sun glint and sky reflection)"),
+        (models.BUDGET_WATER_LEAVING, "water_leaving", "fraction of Ed(0+) that leaves the water"),
+    ]
+    terms += [(models.BUDGET_LAYERS + i, f"absorbed_layer_{i + 1}",
+               f"fraction of Ed(0+) absorbed in water layer {i + 1}") for i in range(n_layers)]
+    terms += [
+        (models.BUDGET_BOTTOM, "absorbed_bottom", "fraction of Ed(0+) absorbed by the bottom"),
+        (models.BUDGET_LOST_BELOW, "lost_below",
+         "fraction of Ed(0+) lost below an infinitely deep, non-absorbing water body"),
+        (models.BUDGET_TRUNCATED, "truncated",
+         "fraction of Ed(0+) still alive when photons reached estimator.max_events (should be 0)"),
+    ]
+    return terms
+
+
+def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_batch: int,
+                 ed0: float, n_layers: int, radiance: bool, attrs: dict) -> Result:
+    """Normalises raw per-batch weight sums (per launched photon, times Ed0; radiances also per
+    quad solid angle) and derives the contract's quantities."""
+    scale = ed0 / n_per_batch
+    omega = grid.solid_angle
+    q: dict[str, Quantity] = {}
+
+    def add(name, dims, values, units, description):
+        q[name] = Quantity(name, dims, np.ascontiguousarray(values, dtype=np.float64), units,
+                           description)
+
+    flux = raw["flux"] * scale
+    add("Ed", ("depth",), flux[:, :, models.FLUX_ED], IRR_UNITS, "downward plane irradiance")
+    add("Eu", ("depth",), flux[:, :, models.FLUX_EU], IRR_UNITS, "upward plane irradiance")
+    add("Eod", ("depth",), flux[:, :, models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance")
+    add("Eou", ("depth",), flux[:, :, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance")
+    add("Eo", ("depth",), flux[:, :, models.FLUX_EOD] + flux[:, :, models.FLUX_EOU], IRR_UNITS,
+        "scalar irradiance Eod + Eou")
+    air = raw["air_flux"] * scale
+    add("air/Ed", (), air[:, models.AIR_ED], IRR_UNITS,
+        "downward plane irradiance just above the surface (0+): sun and sky")
+    add("air/Eu", (), air[:, models.AIR_EU], IRR_UNITS,
+        "upward plane irradiance at 0+: surface-reflected plus water-leaving")
+    add("air/Eu_water_leaving", (), air[:, models.AIR_EU_WATER_LEAVING], IRR_UNITS,
+        "upward plane irradiance at 0+ from light transmitted out of the water only")
+    if radiance:
+        def per_quad(values):
+            out = values * scale / omega
+            caps = grid.is_cap
+            out[..., caps, :] = out[..., caps, :1]  # a cap's one value in every phi column
+            return out
+        rad = per_quad(raw["radiance"])
+        add("radiance", ("depth", "theta", "phi"), rad, RAD_UNITS,
+            "radiance on the (theta, phi) quads, quad average; theta from nadir of the direction "
+            "of travel, phi from the sun's travel azimuth")
+        add("Lu", ("depth",), rad[:, :, -1, 0], RAD_UNITS,
+            "nadir-viewing radiance (upward travel), the polar-cap quad average")
+        air_rad = per_quad(raw["air_radiance"])
+        lw = per_quad(raw["air_lw"])
+        add("air/radiance", ("theta", "phi"), air_rad, RAD_UNITS,
+            "radiance at 0+, all light: sun, sky, surface reflection, water-leaving")
+        add("air/Lw", ("theta", "phi"), lw, RAD_UNITS,
+            "water-leaving radiance at 0+ (surface-reflected light excluded); upward quads only")
+        add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
+            "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
+        add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
+            "nadir water-leaving radiance at 0+, polar-cap quad average")
+        add("air/Rrs_nadir", (), lw[:, -1, 0] / ed0, "sr-1",
+            "remote-sensing reflectance Lw_nadir / Ed(0+)")
+    budget = raw["budget"] / n_per_batch
+    for column, name, description in budget_terms(n_layers):
+        add(f"budget/{name}", (), budget[:, column], "1", description)
+    add("budget/total", (), budget.sum(axis=1), "1",
+        "sum of all budget terms: 1 up to Russian-roulette noise")
+    coords = {
+        "depth": np.asarray(depths, dtype=np.float64),
+        "theta": grid.theta, "phi": grid.phi,
+        "theta_edges": grid.theta_edges, "phi_edges": grid.phi_edges,
+    }
+    attrs = dict(attrs)
+    attrs.setdefault("Lu_method", "polar-cap quad average (theta 175-180 deg with HydroLight "
+                                  "edges), crossing estimator")
+    return Result(coords, q, attrs)
+
+
+# --- HDF5 --------------------------------------------------------------------------------------
+
+COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is 0- "
+                               "(just below the surface)"),
+               "theta": ("deg", "polar angle of the direction of travel from nadir, band centre"),
+               "phi": ("deg", "azimuth of travel from the sun's travel azimuth, band centre"),
+               "theta_edges": ("deg", "theta band edges"),
+               "phi_edges": ("deg", "phi band edges"),
+               "batch": ("1", "independent batch index")}
+
+
+def _write_attrs(obj, attrs: dict) -> None:
+    for key, value in attrs.items():
+        if value is None:
+            continue
+        obj.attrs[key] = value
+
+
+def save_result(result: Result, path: str | Path) -> Path:
+    """Writes the result atomically: a temporary file in the same folder, renamed into place."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w") as f:
+            _write(f, result)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _write(f: h5py.File, result: Result) -> None:
+    _write_attrs(f, result.attrs)
+    f.attrs["format_version"] = FORMAT_VERSION
+    scales = {}
+    for name, values in result.coords.items():
+        ds = f.create_dataset(name, data=values)
+        ds.make_scale(name)
+        ds.attrs["units"], ds.attrs["description"] = COORD_UNITS[name]
+        scales[name] = ds
+    n_batches = next(iter(result.quantities.values())).batches.shape[0]
+    batch = f.create_dataset("batch", data=np.arange(n_batches))
+    batch.make_scale("batch")
+    batch.attrs["units"], batch.attrs["description"] = COORD_UNITS["batch"]
+    scales["batch"] = batch
+    for quantity in result.quantities.values():
+        for suffix, values, desc in (("", quantity.mean, quantity.description),
+                                     ("_stderr", quantity.stderr,
+                                      f"standard error of {quantity.name} over batches")):
+            ds = f.create_dataset(quantity.name + suffix, data=values)
+            ds.attrs["units"] = quantity.units
+            ds.attrs["description"] = desc
+            for axis, dim in enumerate(quantity.dims):
+                ds.dims[axis].attach_scale(scales[dim])
+        ds = f.create_dataset("batches/" + quantity.name, data=quantity.batches,
+                              compression="gzip", compression_opts=4, shuffle=True)
+        ds.attrs["units"] = quantity.units
+        ds.attrs["description"] = f"per-batch values of {quantity.name}"
+        ds.attrs["dims"] = ",".join(quantity.dims)
+        for axis, dim in enumerate(("batch",) + quantity.dims):
+            ds.dims[axis].attach_scale(scales[dim])
+
+
+def load_result(path: str | Path) -> Result:
+    """Reads a results file written by Result.save back into the same Result."""
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
+        coords = {name: f[name][()] for name in COORD_UNITS if name in f and name != "batch"}
+        quantities = {}
+
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                dims = tuple(d for d in _plain(obj.attrs["dims"]).split(",") if d)
+                quantities[name] = Quantity(name, dims, obj[()], _plain(obj.attrs["units"]),
+                                            _plain(f[name].attrs["description"]))
+        f["batches"].visititems(visit)
+    return Result(coords, quantities, attrs)
+
+
+def _plain(value):
+    if isinstance(value, bytes):
+        return value.decode("utf-8")
+    if isinstance(value, np.generic):
+        return value.item()
+    return value

@@ -1,0 +1,186 @@
+"""Config -> scene arrays: everything the compiled kernel needs, as numpy arrays, floats and
+integer model ids. No Python object crosses into the kernel."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import config as cfg
+from . import phase_tables
+from .kernel import models
+from .kernel.scene_arrays import SceneArrays
+
+PURE_WATER_BETA = 0.835   # 0.06225 (1 + 0.835 cos^2): Morel (1974)
+RAYLEIGH_BETA = 1.0
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The angular grid of the radiance tallies (deg). Bands touching a pole are polar caps,
+    not split in azimuth (HydroLight's quads)."""
+    theta_edges: np.ndarray
+    phi_edges: np.ndarray
+    is_cap: np.ndarray
+
+    @property
+    def theta(self) -> np.ndarray:
+        return 0.5 * (self.theta_edges[1:] + self.theta_edges[:-1])
+
+    @property
+    def phi(self) -> np.ndarray:
+        return 0.5 * (self.phi_edges[1:] + self.phi_edges[:-1])
+
+    @property
+    def solid_angle(self) -> np.ndarray:
+        """(theta, phi) quad solid angles in sr; a cap's full solid angle in every phi column."""
+        mu = np.cos(np.radians(self.theta_edges))
+        band = np.abs(mu[:-1] - mu[1:])
+        dphi = np.radians(np.diff(self.phi_edges))
+        omega = band[:, None] * dphi[None, :]
+        omega[self.is_cap, :] = 2.0 * math.pi * band[self.is_cap, None]
+        return omega
+
+
+def make_grid(tallies: cfg.Tallies) -> Grid:
+    edges = np.array(tallies.theta_edges, dtype=np.float64)
+    n = tallies.phi_bands
+    step = 360.0 / n
+    phi_edges = -0.5 * step + step * np.arange(n + 1)
+    is_cap = np.zeros(len(edges) - 1, dtype=np.bool_)
+    is_cap[0] = True
+    is_cap[-1] = True
+    return Grid(edges, phi_edges, is_cap)
+
+
+def _phase_components(phase) -> list[tuple[float, int, list[float], tuple | None]]:
+    """(relative weight, model id, params, table) for each component of a layer's phase."""
+    if isinstance(phase, cfg.Mixture):
+        total = sum(c.b for c in phase.components)
+        out = []
+        for comp in phase.components:
+            share = comp.b / total if total > 0.0 else 1.0 / len(phase.components)
+            out += [(share * w, m, p, t) for w, m, p, t in _phase_components(comp.phase)]
+        return out
+    if isinstance(phase, cfg.Isotropic):
+        return [(1.0, models.PHASE_ISOTROPIC, [], None)]
+    if isinstance(phase, cfg.Rayleigh):
+        return [(1.0, models.PHASE_QUADRATIC, [RAYLEIGH_BETA], None)]
+    if isinstance(phase, cfg.PureWater):
+        return [(1.0, models.PHASE_QUADRATIC, [PURE_WATER_BETA], None)]
+    if isinstance(phase, cfg.HenyeyGreenstein):
+        return [(1.0, models.PHASE_HG, [phase.g], None)]
+    if isinstance(phase, cfg.TwoTermHG):
+        return [(phase.alpha, models.PHASE_HG, [phase.g1], None),
+                (1.0 - phase.alpha, models.PHASE_HG, [phase.g2], None)]
+    if isinstance(phase, cfg.FournierForand):
+        return [(1.0, models.PHASE_TABULATED, [], phase_tables.fournier_forand_table(phase.bb_ratio))]
+    if isinstance(phase, cfg.Petzold):
+        return [(1.0, models.PHASE_TABULATED, [], phase_tables.petzold_table())]
+    if isinstance(phase, cfg.TablePhase):
+        return [(1.0, models.PHASE_TABULATED, [], phase_tables.user_table(phase.file))]
+    raise AssertionError(f"unhandled phase model {phase!r}")
+
+
+def _planes(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Plane depths (surface first, bottom or inf last), the tally level at each plane (-1 for
+    none), the layer of each segment between planes, and the level tallied at 0- (or -1)."""
+    bounds = [0.0]
+    for layer in config.water.layers:
+        bounds.append(bounds[-1] + layer.thickness_m)
+    depths = config.tallies.depths_m
+    plane_z = np.array(sorted(set(bounds) | set(depths)), dtype=np.float64)
+    level_of = {d: i for i, d in enumerate(depths)}
+    plane_tally = np.array([level_of.get(z, -1) for z in plane_z], dtype=np.int64)
+    tops = np.array(bounds[:-1])
+    mids = np.where(np.isinf(plane_z[1:]), plane_z[:-1] + 1.0, 0.5 * (plane_z[1:] + plane_z[:-1]))
+    segment_layer = (np.searchsorted(tops, mids, side="right") - 1).astype(np.int64)
+    return plane_z, plane_tally, segment_layer, int(plane_tally[0])
+
+
+def _bottom(bottom) -> tuple[int, np.ndarray]:
+    ids = {"none": models.BOTTOM_NONE, "black": models.BOTTOM_BLACK,
+           "lambertian": models.BOTTOM_LAMBERTIAN, "minnaert": models.BOTTOM_MINNAERT,
+           "specular": models.BOTTOM_SPECULAR}
+    params = {"lambertian": [getattr(bottom, "reflectance", 0.0)],
+              "minnaert": [getattr(bottom, "reflectance", 0.0), getattr(bottom, "k", 0.0)],
+              "specular": [getattr(bottom, "reflectance", 0.0)]}.get(bottom.model, [])
+    return ids[bottom.model], np.array(params + [0.0] * (4 - len(params)), dtype=np.float64)
+
+
+def _mu_edges(theta_edges: np.ndarray) -> np.ndarray:
+    mu = np.cos(np.radians(theta_edges))
+    mu[theta_edges == 90.0] = 0.0  # exact, so no downward photon lands in an upward band
+    return mu
+
+
+def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
+    """The kernel's view of a validated scene, and the tally grid. Raises TableError (a
+    ConfigError) for unusable auxiliary files."""
+    layers = config.water.layers
+    comp_start, comp_count, cumweight, comp_model, comp_params = [], [], [], [], []
+    tab_start, tab_len, psi_parts, q_parts, cdf_parts = [], [], [], [], []
+    tab_offset = 0
+    table_cache: dict[int, tuple[int, int]] = {}
+    for layer in layers:
+        comps = _phase_components(layer.phase)
+        comp_start.append(len(comp_model))
+        comp_count.append(len(comps))
+        total = sum(w for w, *_ in comps)
+        running = 0.0
+        for weight, model, params, table in comps:
+            running += weight / total
+            cumweight.append(running)
+            comp_model.append(model)
+            comp_params.append(list(params) + [0.0] * (2 - len(params)))
+            if table is None:
+                tab_start.append(0)
+                tab_len.append(0)
+                continue
+            key = id(table[0])
+            if key not in table_cache:
+                table_cache[key] = (tab_offset, len(table[0]))
+                psi_parts.append(table[0])
+                q_parts.append(table[1])
+                cdf_parts.append(table[2])
+                tab_offset += len(table[0])
+            tab_start.append(table_cache[key][0])
+            tab_len.append(table_cache[key][1])
+        cumweight[-1] = 1.0
+
+    def flat(parts):
+        return np.concatenate(parts) if parts else np.zeros(1)
+
+    plane_z, plane_tally, segment_layer, surface_tally = _planes(config)
+    bottom_model, bottom_params = _bottom(config.bottom)
+    grid = make_grid(config.tallies)
+    ill = config.illumination
+    theta_s = math.radians(ill.sun_zenith_deg)
+    sc = SceneArrays(
+        sun_mu=math.cos(theta_s), sun_sin=math.sin(theta_s),
+        diffuse_fraction=float(ill.diffuse_fraction),
+        sky_model=models.SKY_CARDIOIDAL if ill.sky == "cardioidal" else models.SKY_UNIFORM,
+        surface_flat=config.surface.model == "flat", n_water=float(config.n_water),
+        plane_z=plane_z, plane_tally=plane_tally, segment_layer=segment_layer,
+        layer_a=np.array([layer.a for layer in layers], dtype=np.float64),
+        layer_b=np.array([layer.b for layer in layers], dtype=np.float64),
+        layer_comp_start=np.array(comp_start, dtype=np.int64),
+        layer_comp_count=np.array(comp_count, dtype=np.int64),
+        comp_cumweight=np.array(cumweight, dtype=np.float64),
+        comp_model=np.array(comp_model, dtype=np.int64),
+        comp_params=np.array(comp_params, dtype=np.float64),
+        comp_tab_start=np.array(tab_start, dtype=np.int64),
+        comp_tab_len=np.array(tab_len, dtype=np.int64),
+        tab_psi=flat(psi_parts), tab_q=flat(q_parts), tab_cdf=flat(cdf_parts),
+        bottom_model=bottom_model, bottom_params=bottom_params,
+        theta_mu_edges=_mu_edges(grid.theta_edges),
+        theta_is_cap=grid.is_cap, n_phi=int(config.tallies.phi_bands),
+        tally_radiance=bool(config.tallies.radiance), surface_tally=surface_tally,
+        mu_cut=float(config.tallies.grazing_mu_cut),
+        analog=config.estimator.mode == "analog",
+        roulette_weight=float(config.estimator.roulette_weight),
+        roulette_survival=float(config.estimator.roulette_survival),
+        max_events=int(config.estimator.max_events),
+    )
+    return sc, grid
