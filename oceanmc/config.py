@@ -158,8 +158,11 @@ class Illumination(_Strict):
 
 
 class Surface(_Strict):
+    """flat: exact unpolarized Fresnel + Snell; none: no interface (index-matched, n = 1).
+    fresnel: schlick swaps in Schlick's approximation, for comparisons only (never exact)."""
     model: Literal["flat", "none"] = "flat"
     n_water: Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.34
+    fresnel: Literal["exact", "schlick"] = "exact"
 
 
 class NoBottom(_Strict):

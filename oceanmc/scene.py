@@ -162,6 +162,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         diffuse_fraction=float(ill.diffuse_fraction),
         sky_model=models.SKY_CARDIOIDAL if ill.sky == "cardioidal" else models.SKY_UNIFORM,
         surface_flat=config.surface.model == "flat", n_water=float(config.n_water),
+        fresnel_schlick=config.surface.fresnel == "schlick",
         plane_z=plane_z, plane_tally=plane_tally, segment_layer=segment_layer,
         layer_a=np.array([layer.a for layer in layers], dtype=np.float64),
         layer_b=np.array([layer.b for layer in layers], dtype=np.float64),

@@ -25,6 +25,26 @@ def fresnel(n1, n2, cos_i):
 
 
 @njit(cache=True)
+def schlick(n1, n2, cos_i):
+    """Schlick's approximation R0 + (1 - R0)(1 - cos)^5 (Schlick 1994), with the cosine taken on
+    the less dense side and total internal reflection kept: offered for comparisons only."""
+    r_exact, cos_t = fresnel(n1, n2, cos_i)
+    if r_exact >= 1.0:
+        return 1.0, cos_t
+    r0 = ((n1 - n2) / (n1 + n2)) ** 2
+    c = cos_i if n1 <= n2 else cos_t
+    return r0 + (1.0 - r0) * (1.0 - c) ** 5, cos_t
+
+
+@njit(cache=True)
+def reflectance(sc, n1, n2, cos_i):
+    """(R, cos_t) with the scene's choice of formula."""
+    if sc.fresnel_schlick:
+        return schlick(n1, n2, cos_i)
+    return fresnel(n1, n2, cos_i)
+
+
+@njit(cache=True)
 def refract(ux, uy, uz, ratio, cos_t):
     """Direction after crossing a horizontal interface: tangential components scale by
     ratio = n1/n2 (Snell), the vertical one keeps its sign with magnitude cos_t."""

@@ -10,7 +10,7 @@ SceneArrays = namedtuple("SceneArrays", [
     # illumination
     "sun_mu", "sun_sin", "diffuse_fraction", "sky_model",
     # surface
-    "surface_flat", "n_water",
+    "surface_flat", "n_water", "fresnel_schlick",
     # geometry and water
     "plane_z", "plane_tally", "segment_layer", "layer_a", "layer_b",
     # phase functions: a layer's components layer_comp_start .. + layer_comp_count

@@ -16,7 +16,7 @@ from numba import njit
 
 from .brdf import dispatch as brdf
 from .geometry import from_angles, turn
-from .interface import fresnel, refract
+from .interface import reflectance, refract
 from .models import (BOTTOM_BLACK, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
 from .phase import dispatch as phase
@@ -48,7 +48,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
     score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz)
     n = sc.n_water
     if sc.surface_flat:
-        r, cos_t = fresnel(1.0, n, uz)
+        r, cos_t = reflectance(sc, 1.0, n, uz)
         if sc.analog:
             if np.random.random() < r:
                 score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, -uz, False)
@@ -137,7 +137,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
                 score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, True)
                 budget[BUDGET_WATER_LEAVING] += w
                 return events
-            r, cos_t = fresnel(n, 1.0, -uz)
+            r, cos_t = reflectance(sc, n, 1.0, -uz)
             if sc.analog:
                 if np.random.random() >= r:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
