@@ -300,6 +300,7 @@ def _key_path(loc: tuple) -> str:
 def _describe(error: dict) -> str:
     path = _key_path(tuple(error.get("loc", ())))
     kind = error.get("type", "")
+    ctx = error.get("ctx") or {}
     msg = error.get("msg", "invalid")
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
@@ -307,13 +308,17 @@ def _describe(error: dict) -> str:
         return f"{path}: unknown key (check its spelling and level)"
     if kind == "missing":
         return f"{path}: required key is missing"
-    if "input" in error and kind not in ("model_type", "dict_type"):
-        value = error["input"]
-        shown = repr(value)
+    if kind == "union_tag_invalid":
+        return (f"{path}.model = {ctx.get('tag')!r}: unknown model; allowed: "
+                f"{ctx.get('expected_tags')}")
+    if kind == "union_tag_not_found":
+        return f"{path}.model: required key is missing"
+    if path == "(top level)" and kind == "value_error":
+        return msg
+    if "input" in error and not isinstance(error["input"], dict):
+        shown = repr(error["input"])
         if len(shown) > 80:
             shown = shown[:77] + "..."
-        if isinstance(value, dict):
-            return f"{path}: {msg}"
         return f"{path} = {shown}: {msg}"
     return f"{path}: {msg}"
 

@@ -16,8 +16,10 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
+from .config import ConfigError
 
-class TableError(ValueError):
+
+class TableError(ConfigError):
     """An auxiliary table that cannot be used; the message names the file and the problem."""
 
 

@@ -187,35 +187,42 @@ def save_result(result: Result, path: str | Path) -> Path:
 
 
 def _write(f: h5py.File, result: Result) -> None:
+    """Each group holds the coordinates its variables use, as dimension scales, so that
+    xarray.open_dataset(path, engine="h5netcdf", group=...) names every dimension."""
     _write_attrs(f, result.attrs)
     f.attrs["format_version"] = FORMAT_VERSION
-    scales = {}
-    for name, values in result.coords.items():
-        ds = f.create_dataset(name, data=values)
-        ds.make_scale(name)
-        ds.attrs["units"], ds.attrs["description"] = COORD_UNITS[name]
-        scales[name] = ds
     n_batches = next(iter(result.quantities.values())).batches.shape[0]
-    batch = f.create_dataset("batch", data=np.arange(n_batches))
-    batch.make_scale("batch")
-    batch.attrs["units"], batch.attrs["description"] = COORD_UNITS["batch"]
-    scales["batch"] = batch
-    for quantity in result.quantities.values():
-        for suffix, values, desc in (("", quantity.mean, quantity.description),
-                                     ("_stderr", quantity.stderr,
-                                      f"standard error of {quantity.name} over batches")):
-            ds = f.create_dataset(quantity.name + suffix, data=values)
-            ds.attrs["units"] = quantity.units
-            ds.attrs["description"] = desc
-            for axis, dim in enumerate(quantity.dims):
-                ds.dims[axis].attach_scale(scales[dim])
-        ds = f.create_dataset("batches/" + quantity.name, data=quantity.batches,
-                              compression="gzip", compression_opts=4, shuffle=True)
-        ds.attrs["units"] = quantity.units
-        ds.attrs["description"] = f"per-batch values of {quantity.name}"
-        ds.attrs["dims"] = ",".join(quantity.dims)
-        for axis, dim in enumerate(("batch",) + quantity.dims):
-            ds.dims[axis].attach_scale(scales[dim])
+    coords = dict(result.coords, batch=np.arange(n_batches))
+    scales: dict[tuple[str, str], h5py.Dataset] = {}
+
+    def scale(group: str, dim: str) -> h5py.Dataset:
+        if (group, dim) not in scales:
+            ds = f.require_group(group or "/").create_dataset(dim, data=coords[dim])
+            ds.make_scale(dim)
+            ds.attrs["units"], ds.attrs["description"] = COORD_UNITS[dim]
+            scales[group, dim] = ds
+        return scales[group, dim]
+
+    def write(name: str, values: np.ndarray, dims: tuple[str, ...], units: str, desc: str,
+              **options) -> h5py.Dataset:
+        ds = f.create_dataset(name, data=values, **options)
+        ds.attrs["units"] = units
+        ds.attrs["description"] = desc
+        group = name.rpartition("/")[0]
+        for axis, dim in enumerate(dims):
+            ds.dims[axis].attach_scale(scale(group, dim))
+        return ds
+
+    for name in result.coords:
+        scale("", name)
+    for q in result.quantities.values():
+        write(q.name, q.mean, q.dims, q.units, q.description)
+        write(q.name + "_stderr", q.stderr, q.dims, q.units,
+              f"standard error of {q.name} over batches")
+        ds = write("batches/" + q.name, q.batches, ("batch",) + q.dims, q.units,
+                   f"per-batch values of {q.name}", compression="gzip", compression_opts=4,
+                   shuffle=True)
+        ds.attrs["dims"] = ",".join(q.dims)
 
 
 def load_result(path: str | Path) -> Result:
@@ -223,16 +230,23 @@ def load_result(path: str | Path) -> Result:
     path = Path(path)
     with h5py.File(path, "r") as f:
         attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
-        coords = {name: f[name][()] for name in COORD_UNITS if name in f and name != "batch"}
+        coords = {name: f[name][()] for name in ("depth", "theta", "phi", "theta_edges",
+                                                 "phi_edges")}
         quantities = {}
 
         def visit(name, obj):
             if isinstance(obj, h5py.Dataset):
-                dims = tuple(d for d in _plain(obj.attrs["dims"]).split(",") if d)
-                quantities[name] = Quantity(name, dims, obj[()], _plain(obj.attrs["units"]),
+                if "dims" not in obj.attrs:
+                    return  # a coordinate of the batches group
+                quantities[name] = Quantity(name, dims_of(obj), obj[()],
+                                            _plain(obj.attrs["units"]),
                                             _plain(f[name].attrs["description"]))
         f["batches"].visititems(visit)
     return Result(coords, quantities, attrs)
+
+
+def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:
+    return tuple(d for d in _plain(dataset.attrs["dims"]).split(",") if d)
 
 
 def _plain(value):
@@ -241,3 +255,49 @@ def _plain(value):
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+# --- the printed summary -----------------------------------------------------------------------
+
+def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
+    """(label, units, value, standard error) for the headline quantities of a run."""
+    rows = []
+
+    def row(label, name, units, index=None):
+        if name not in result:
+            return
+        value, err = result[name], result.stderr(name)
+        if index is not None:
+            value, err = value[index], err[index]
+        rows.append((label, units, float(value), float(err)))
+
+    row("Ed(0+)", "air/Ed", "W/m2")
+    row("Eu(0+)", "air/Eu", "W/m2")
+    row("Lu(0+) nadir", "air/Lu", "W/m2/sr")
+    row("Lw nadir", "air/Lw_nadir", "W/m2/sr")
+    row("Rrs nadir", "air/Rrs_nadir", "1/sr")
+    for i, depth in enumerate(result.coords["depth"]):
+        where = "0-" if depth == 0.0 else f"{depth:g} m"
+        row(f"Ed({where})", "Ed", "W/m2", i)
+        row(f"Eu({where})", "Eu", "W/m2", i)
+        row(f"Eo({where})", "Eo", "W/m2", i)
+        row(f"Lu({where})", "Lu", "W/m2/sr", i)
+    for name in result.quantities:
+        if name.startswith("budget/"):
+            row("budget " + name.split("/", 1)[1], name, "1")
+    return rows
+
+
+def format_summary(result: Result) -> str:
+    a = result.attrs
+    lines = [
+        f"{a.get('name', '')}",
+        f"  {a['photons']:,} photons in {a['batches']} batches on {a['threads']} thread(s): "
+        f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
+        f"(start-up {a['startup_time_s']:.2f} s)",
+        f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}",
+    ]
+    for label, units, value, err in summary_rows(result):
+        rel = abs(err / value) if value != 0.0 else 0.0
+        lines.append(f"  {label:<28}{units:<9}{value:>13.6g}{err:>12.3g}{rel:>10.2%}")
+    return "\n".join(lines)

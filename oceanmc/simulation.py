@@ -38,8 +38,8 @@ def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
 def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str, np.ndarray]:
     nt, npf = (len(grid.theta), len(grid.phi)) if sc.tally_radiance else (1, 1)
     return {
-        "flux": np.zeros((n_batches, max(n_depths, 1), 4)),
-        "radiance": np.zeros((n_batches, max(n_depths, 1), nt, npf)),
+        "flux": np.zeros((n_batches, n_depths, 4)),
+        "radiance": np.zeros((n_batches, n_depths, nt, npf)),
         "air_flux": np.zeros((n_batches, 3)),
         "air_radiance": np.zeros((n_batches, nt, npf)),
         "air_lw": np.zeros((n_batches, nt, npf)),

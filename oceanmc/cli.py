@@ -1,0 +1,175 @@
+"""The `oceanmc` command: run scenes, validate the physics, show results files.
+
+Exit status: 0 success, 1 a failed validation or a run that could not finish, 2 bad input (a
+config, a path, an option), 130 interrupted.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+from . import __version__
+
+
+class UsageError(Exception):
+    """Bad command-line input; the message says what and why."""
+
+
+def _outputs(configs: list[Path], out: str | None) -> list[Path]:
+    """One results file per config: -o FILE for a single config, -o DIR for several (or one),
+    else results/<config name>.h5."""
+    if out is None:
+        return [Path("results") / f"{c.stem}.h5" for c in configs]
+    target = Path(out)
+    if target.suffix in (".h5", ".hdf5", ".nc") and not target.is_dir():
+        if len(configs) > 1:
+            raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
+        return [target]
+    return [target / f"{c.stem}.h5" for c in configs]
+
+
+def _check_writable(path: Path, overwrite: bool) -> None:
+    """Fails before any photon is traced if the results file cannot be written."""
+    if path.exists() and not overwrite:
+        raise UsageError(f"{path} exists; pass --overwrite to replace it")
+    if path.exists() and path.is_dir():
+        raise UsageError(f"{path} is a folder, not a results file")
+    folder = path.parent if str(path.parent) else Path(".")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".oceanmc-write-test-"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"cannot write results to {folder}: {exc.strerror or exc}") from None
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from .config import ConfigError, load_config
+    from .simulation import simulate
+    from .results import format_summary
+
+    configs = [Path(c) for c in args.configs]
+    outputs = _outputs(configs, args.output)
+    if len(set(outputs)) != len(outputs):
+        raise UsageError("two configs share a file name; give them different names or run them "
+                         "separately with -o")
+    overrides = {"photons": args.photons, "seed": args.seed}
+    scenes = []
+    for path, out in zip(configs, outputs):
+        try:
+            scenes.append(load_config(path, overrides))
+        except ConfigError as exc:
+            print(f"oceanmc: config error: {exc}", file=sys.stderr)
+            return 2
+        _check_writable(out, args.overwrite)
+    for path, out, config in zip(configs, outputs, scenes):
+        try:
+            result = simulate(config, threads=args.threads, progress=not args.quiet)
+        except ConfigError as exc:  # auxiliary tables are read when the scene is built
+            print(f"oceanmc: config error: {path}: {exc}", file=sys.stderr)
+            return 2
+        result.attrs["config_file"] = str(path)
+        result.save(out)
+        print(format_summary(result))
+        print(f"  wrote {out}")
+        print()
+    return 0
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    from .results import format_summary, load_result
+
+    path = Path(args.file)
+    if not path.is_file():
+        raise UsageError(f"{path}: no such file")
+    try:
+        result = load_result(path)
+    except (OSError, KeyError, ValueError) as exc:
+        raise UsageError(f"{path}: not an oceanmc results file ({exc})") from None
+    print(format_summary(result))
+    if args.config:
+        print(result.config_yaml)
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from . import validation
+
+    return validation.main(Path(args.output), quick=args.quick)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="oceanmc",
+        description="Monte Carlo radiative transfer for natural waters: layered water, flat "
+                    "Fresnel surface, BRDF bottom, sun and sky.")
+    parser.add_argument("--version", action="version", version=f"oceanmc {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = sub.add_parser("run", help="run one or more YAML scenes, write one HDF5 file each")
+    run.add_argument("configs", nargs="+", metavar="CONFIG.yaml")
+    run.add_argument("-o", "--output", metavar="OUT",
+                     help="results file (one config) or folder (default: results/<name>.h5)")
+    run.add_argument("--photons", type=_positive_int, help="photon packets (overrides config)")
+    run.add_argument("--seed", type=_non_negative_int, help="random seed (overrides config)")
+    run.add_argument("--threads", type=_positive_int,
+                     help="threads (default: all cores); results do not depend on it")
+    run.add_argument("--overwrite", action="store_true", help="replace existing results files")
+    run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    run.set_defaults(func=cmd_run)
+
+    validate = sub.add_parser("validate", help="run the validation suite and write its report")
+    validate.add_argument("-o", "--output", default="validation", metavar="DIR",
+                          help="report folder (default: validation)")
+    validate.add_argument("--quick", action="store_true",
+                          help="fewer photons: a fast check, looser standard errors")
+    validate.set_defaults(func=cmd_validate)
+
+    show = sub.add_parser("show", help="print the summary of a results file")
+    show.add_argument("file", metavar="RESULT.h5")
+    show.add_argument("--config", action="store_true", help="also print the stored scene")
+    show.set_defaults(func=cmd_show)
+    return parser
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(float(text)) if "e" in text.lower() else int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return value
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except UsageError as exc:
+        print(f"oceanmc: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("oceanmc: interrupted; no partial results file was written", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

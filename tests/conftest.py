@@ -1,0 +1,25 @@
+import copy
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+SMALL_SCENE = {
+    "name": "small test scene",
+    "photons": 20000,
+    "batches": 8,
+    "seed": 5,
+    "illumination": {"Ed0": 1.0, "sun_zenith_deg": 30, "diffuse_fraction": 0.2},
+    "surface": {"model": "flat", "n_water": 1.34},
+    "water": {"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4,
+                          "phase": {"model": "henyey_greenstein", "g": 0.8}}]},
+    "bottom": {"model": "lambertian", "reflectance": 0.3},
+    "tallies": {"depths_m": [0, 1, 2]},
+}
+
+
+@pytest.fixture
+def small_scene():
+    """A fresh deep copy of a fast scene (a mutable dict each test may change)."""
+    return copy.deepcopy(SMALL_SCENE)

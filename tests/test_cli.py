@@ -1,0 +1,140 @@
+"""The `oceanmc` command as a user runs it: exit codes, messages, files."""
+import os
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from conftest import REPO
+
+ENV = dict(os.environ, PYTHONPATH=str(REPO))
+
+
+def oceanmc(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "oceanmc", *map(str, args)], cwd=cwd, env=ENV,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture
+def scene_file(tmp_path, small_scene):
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene))
+    return path
+
+
+def test_run_writes_results_and_prints_summary(tmp_path, scene_file):
+    done = oceanmc("run", scene_file, "--threads", "2", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = tmp_path / "results" / "scene.h5"
+    assert out.is_file()
+    for word in ("photons/s", "Ed(0+)", "Rrs nadir", "std err", "rel err", "budget total",
+                 f"wrote {out.relative_to(tmp_path)}"):
+        assert word in done.stdout, word
+    with h5py.File(out) as f:
+        assert f.attrs["photons"] == 20000
+        assert "Rrs_nadir" in f["air"]
+
+
+def test_several_configs_run_in_turn_into_a_folder(tmp_path, scene_file, small_scene):
+    second = tmp_path / "second.yaml"
+    small_scene["name"] = "second"
+    second.write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", scene_file, second, "-o", "out", "-q", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["scene.h5", "second.h5"]
+
+
+def test_photons_and_seed_options_override_the_config(tmp_path, scene_file):
+    done = oceanmc("run", scene_file, "-o", "x.h5", "--photons", "8000", "--seed", "3", "-q",
+                   cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    with h5py.File(tmp_path / "x.h5") as f:
+        assert (f.attrs["photons"], f.attrs["seed"]) == (8000, 3)
+        assert "seed: 3" in f.attrs["config_yaml"]
+
+
+def test_bad_config_exits_2_with_one_clear_line_and_no_file(tmp_path, small_scene):
+    small_scene["water"]["layers"][0]["a"] = -0.1
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", path, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr
+    assert "water.layers[0].a = -0.1" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "results").exists() or not any((tmp_path / "results").iterdir())
+
+
+def test_a_bad_config_among_several_stops_before_any_run(tmp_path, scene_file):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("water: {layers: [{thickness_m: 1, a: 0.1, b: 0.1}]}\nbottom: {model: mud}\n")
+    done = oceanmc("run", scene_file, bad, cwd=tmp_path)
+    assert done.returncode == 2
+    assert "bottom.model = 'mud'" in done.stderr
+    assert not (tmp_path / "results" / "scene.h5").exists()
+
+
+def test_missing_config_and_bad_options(tmp_path):
+    done = oceanmc("run", tmp_path / "nope.yaml", cwd=tmp_path)
+    assert done.returncode == 2 and "no such file" in done.stderr
+    done = oceanmc("run", "x.yaml", "--photons", "-5", cwd=tmp_path)
+    assert done.returncode == 2 and "positive integer" in done.stderr
+    done = oceanmc("frobnicate", cwd=tmp_path)
+    assert done.returncode == 2
+
+
+def test_existing_results_are_not_overwritten_without_the_flag(tmp_path, scene_file):
+    target = tmp_path / "r.h5"
+    target.write_bytes(b"precious")
+    done = oceanmc("run", scene_file, "-o", target, "-q", cwd=tmp_path)
+    assert done.returncode == 2 and "--overwrite" in done.stderr
+    assert target.read_bytes() == b"precious"
+    done = oceanmc("run", scene_file, "-o", target, "-q", "--overwrite", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert h5py.is_hdf5(target)
+
+
+def test_unwritable_output_fails_before_running(tmp_path, scene_file):
+    """A results folder that cannot be made (a file stands in its place) fails at once, even for
+    root, before any photon is traced."""
+    (tmp_path / "blocker").write_text("a file, not a folder")
+    done = oceanmc("run", scene_file, "-o", tmp_path / "blocker" / "r.h5", cwd=tmp_path)
+    assert done.returncode == 2 and "cannot write" in done.stderr
+    assert "photons/s" not in done.stdout
+
+
+def test_show_prints_the_summary(tmp_path, scene_file):
+    assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0
+    done = oceanmc("show", "r.h5", "--config", cwd=tmp_path)
+    assert done.returncode == 0
+    assert "Ed(0-)" in done.stdout and "water:" in done.stdout
+    done = oceanmc("show", scene_file, cwd=tmp_path)
+    assert done.returncode == 2 and "not an oceanmc results file" in done.stderr
+
+
+def test_same_seed_gives_identical_files_apart_from_times(tmp_path, scene_file):
+    for name, threads in (("a.h5", "1"), ("b.h5", "2")):
+        done = oceanmc("run", scene_file, "-o", name, "-q", "--threads", threads, cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+    timing = {"wall_time_s", "startup_time_s", "photons_per_s", "threads"}
+    with h5py.File(tmp_path / "a.h5") as a, h5py.File(tmp_path / "b.h5") as b:
+        assert {k: a.attrs[k] for k in a.attrs if k not in timing} == \
+               {k: b.attrs[k] for k in b.attrs if k not in timing}
+        names = []
+        a.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        assert len(names) > 50
+        for name in names:
+            assert np.array_equal(a[name][()], b[name][()], equal_nan=True), name
+
+
+def test_kernel_runs_without_jit(tmp_path, scene_file):
+    """The kernel is plain Python under NUMBA_DISABLE_JIT=1 (for debugging and coverage)."""
+    env = dict(ENV, NUMBA_DISABLE_JIT="1")
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "run", str(scene_file), "-o", "r.h5",
+                           "--photons", "400", "-q"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "budget total" in done.stdout

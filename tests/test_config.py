@@ -1,0 +1,194 @@
+"""Config loading and validation: every bad scene gets one clear ConfigError naming the key path,
+the value and what is allowed."""
+import math
+
+import pytest
+import yaml
+
+import oceanmc
+from oceanmc.config import ConfigError, config_to_yaml, load_config
+
+from conftest import REPO
+
+
+def test_shipped_configs_load():
+    for path in sorted((REPO / "configs").glob("*.yaml")):
+        config = load_config(path)
+        assert config.photons > 0, path
+
+
+def test_defaults_are_filled_in(small_scene):
+    del small_scene["tallies"]
+    config = load_config(small_scene)
+    assert config.tallies.phi_bands == 24
+    assert config.tallies.theta_edges[1] == 5.0 and len(config.tallies.theta_edges) == 21
+    assert config.estimator.mode == "implicit"
+    assert config.surface.fresnel == "exact"
+
+
+def test_round_trip_through_yaml(small_scene, tmp_path):
+    config = load_config(small_scene)
+    path = tmp_path / "again.yaml"
+    path.write_text(config_to_yaml(config))
+    assert load_config(path) == config
+
+
+def test_infinite_thickness_round_trips(tmp_path):
+    scene = {"water": {"layers": [{"thickness_m": math.inf, "a": 0.1, "b": 0.2}]},
+             "bottom": {"model": "none"}}
+    text = config_to_yaml(load_config(scene))
+    assert ".inf" in text
+    assert math.isinf(load_config(yaml.safe_load(text)).water.layers[0].thickness_m)
+
+
+def test_overrides_replace_photons_and_seed(small_scene):
+    config = load_config(small_scene, {"photons": 1234, "seed": 9})
+    assert (config.photons, config.seed) == (1234, 9)
+
+
+def test_mixture_b_is_the_sum_of_its_components():
+    scene = {"water": {"layers": [{"thickness_m": 1, "a": 0.1, "phase": {
+        "model": "mixture", "components": [
+            {"b": 0.002, "phase": {"model": "pure_water"}},
+            {"b": 0.3, "phase": {"model": "petzold"}}]}}]},
+        "bottom": {"model": "black"}}
+    assert load_config(scene).water.layers[0].b == pytest.approx(0.302)
+
+
+def _error(scene) -> str:
+    with pytest.raises(ConfigError) as info:
+        load_config(scene)
+    return str(info.value)
+
+
+@pytest.mark.parametrize("change, key, fragment", [
+    (lambda s: s["water"]["layers"][0].update(a=-1), "water.layers[0].a = -1",
+     "greater than or equal to 0"),
+    (lambda s: s["water"]["layers"][0].update(b=-0.5), "water.layers[0].b = -0.5",
+     "greater than or equal to 0"),
+    (lambda s: s["water"]["layers"][0]["phase"].update(g=1.0),
+     "water.layers[0].phase.g = 1.0", "less than 1"),
+    (lambda s: s["water"]["layers"][0]["phase"].update(g=-1.0),
+     "water.layers[0].phase.g = -1.0", "greater than -1"),
+    (lambda s: s["surface"].update(n_water=0.9), "surface.n_water = 0.9",
+     "greater than or equal to 1"),
+    (lambda s: s["bottom"].update(reflectance=1.5), "bottom.reflectance = 1.5",
+     "less than or equal to 1"),
+    (lambda s: s["bottom"].update(reflectance=-0.1), "bottom.reflectance = -0.1",
+     "greater than or equal to 0"),
+    (lambda s: s["illumination"].update(sun_zenith_deg=90), "illumination.sun_zenith_deg = 90",
+     "less than 90"),
+    (lambda s: s["illumination"].update(sun_zenith_deg=-1), "illumination.sun_zenith_deg = -1",
+     "greater than or equal to 0"),
+    (lambda s: s["illumination"].update(diffuse_fraction=1.2),
+     "illumination.diffuse_fraction = 1.2", "less than or equal to 1"),
+    (lambda s: s["illumination"].update(sky="stormy"), "illumination.sky = 'stormy'",
+     "'uniform' or 'cardioidal'"),
+    (lambda s: s.update(photons=0), "photons = 0", "greater than 0"),
+    (lambda s: s.update(photons="many"), "photons = 'many'", "integer"),
+    (lambda s: s["tallies"].update(depths_m=[0, 5]), "tallies.depths_m", "below the bottom"),
+    (lambda s: s["tallies"].update(depths_m=[-1]), "tallies.depths_m[0] = -1",
+     "greater than or equal to 0"),
+    (lambda s: s["tallies"].update(theta_edges_deg=[0, 100, 90, 180]), "tallies.theta_edges_deg",
+     "increase"),
+    (lambda s: s["water"]["layers"][0].update(colour="blue"), "water.layers[0].colour",
+     "unknown key"),
+    (lambda s: s.update(photon=5), "photon", "unknown key"),
+    (lambda s: s["bottom"].update(model="mud"), "bottom.model = 'mud'", "allowed"),
+    (lambda s: s["bottom"].update(model="minnaert"), "bottom.k", "missing"),
+    (lambda s: s["water"]["layers"][0].update(a=math.nan), "water.layers[0].a = nan", "finite"),
+    (lambda s: s["water"]["layers"][0].update(thickness_m=0), "water.layers[0].thickness_m = 0",
+     "greater than 0"),
+    (lambda s: s["water"]["layers"][0]["phase"].update(model="mie"),
+     "water.layers[0].phase.model = 'mie'", "'petzold'"),
+    (lambda s: s["water"]["layers"][0]["phase"].pop("model"), "water.layers[0].phase.model",
+     "missing"),
+    (lambda s: s.update(water={"layers": []}), "water.layers", "at least 1"),
+])
+def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragment):
+    change(small_scene)
+    message = _error(small_scene)
+    assert key in message, message
+    assert fragment in message, message
+    assert "Traceback" not in message
+
+
+def test_bottom_none_needs_an_infinitely_deep_layer(small_scene):
+    small_scene["bottom"] = {"model": "none"}
+    assert "infinitely deep" in _error(small_scene)
+
+
+def test_infinite_layer_needs_bottom_none(small_scene):
+    small_scene["water"]["layers"][0]["thickness_m"] = math.inf
+    assert "bottom.model = 'lambertian'" in _error(small_scene)
+
+
+def test_only_the_last_layer_may_be_infinite(small_scene):
+    small_scene["water"]["layers"] = [{"thickness_m": math.inf, "a": 0.1, "b": 0.1},
+                                      {"thickness_m": 1, "a": 0.1, "b": 0.1}]
+    assert "only the last layer" in _error(small_scene)
+
+
+def test_conservative_infinite_scatterer_is_refused():
+    scene = {"water": {"layers": [{"thickness_m": math.inf, "a": 0.0, "b": 0.1}]},
+             "bottom": {"model": "none"}}
+    assert "needs a > 0" in _error(scene)
+
+
+def test_mixture_b_mismatch_is_refused():
+    scene = {"water": {"layers": [{"thickness_m": 1, "a": 0.1, "b": 1.0, "phase": {
+        "model": "mixture", "components": [{"b": 0.3, "phase": {"model": "petzold"}}]}}]},
+        "bottom": {"model": "black"}}
+    assert "sum of the mixture" in _error(scene)
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("", "empty"),
+    ("- 1\n- 2\n", "top level must be a mapping"),
+    ("water: [unclosed\n", "not valid YAML"),
+    ("name: x\n", "water: required key is missing"),
+])
+def test_bad_files(tmp_path, text, fragment):
+    path = tmp_path / "scene.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert fragment in str(info.value)
+    assert str(path) in str(info.value)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ConfigError, match="no such file"):
+        load_config(tmp_path / "nope.yaml")
+
+
+def test_table_phase_path_is_relative_to_the_config(tmp_path):
+    (tmp_path / "vsf.csv").write_text("0,10\n90,1\n180,2\n")
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump({
+        "water": {"layers": [{"thickness_m": 1, "a": 0.1, "b": 0.1,
+                              "phase": {"model": "table", "file": "vsf.csv"}}]},
+        "bottom": {"model": "black"}}))
+    config = load_config(path)
+    assert config.water.layers[0].phase.file == str(tmp_path / "vsf.csv")
+
+
+@pytest.mark.parametrize("content, fragment", [
+    (None, "no such file"),
+    ("", "at least 2 rows"),
+    ("0,1\n90,x\n", "not a number"),
+    ("0,1,2\n90,1,2\n", "expected 2 columns"),
+    ("0,1\n90,-1\n180,1\n", "negative"),
+    ("0,1\n90,1\n45,1\n", "increase strictly"),
+    ("0,1\n90,nan\n", "NaN"),
+    ("0,1\n200,1\n", "0..180"),
+])
+def test_bad_phase_tables_name_the_file(tmp_path, small_scene, content, fragment):
+    table = tmp_path / "vsf.csv"
+    if content is not None:
+        table.write_text(content)
+    small_scene["water"]["layers"][0]["phase"] = {"model": "table", "file": str(table)}
+    with pytest.raises(ConfigError) as info:
+        oceanmc.simulate(small_scene)
+    assert fragment in str(info.value)
+    assert str(table) in str(info.value)
