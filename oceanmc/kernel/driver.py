@@ -6,7 +6,7 @@ from numba import njit, prange
 from .transport import trace_batch
 
 
-@njit(parallel=True, cache=True)
+@njit(parallel=True, error_model="numpy", cache=True)
 def run_batches(sc, n_photons, seeds, flux, radiance, air_flux, air_radiance, air_lw, budget,
                 events):
     for i in prange(seeds.shape[0]):

@@ -8,7 +8,7 @@ from numba import njit
 from .models import SKY_CARDIOIDAL
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def sky_cosine(sky_model):
     """Cosine of the travel direction's angle from nadir for a sky photon: density proportional to
     L(theta) cos(theta). Uniform L: cos = sqrt(u). Cardioidal L ~ 1 + 2 cos: the cosine-weighted

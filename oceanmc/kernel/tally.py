@@ -10,7 +10,7 @@ from numba import njit
 from .models import AIR_ED, AIR_EU, AIR_EU_WATER_LEAVING, FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def theta_band(uz, mu_edges):
     """Index i with mu_edges[i] >= uz > mu_edges[i + 1] (mu_edges falls from 1 to -1)."""
     lo = 0
@@ -24,7 +24,7 @@ def theta_band(uz, mu_edges):
     return lo
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def phi_band(ux, uy, n_phi):
     """Band index with band 0 centred on phi = 0 (the sun's travel azimuth)."""
     phi = math.atan2(uy, ux)
@@ -32,20 +32,20 @@ def phi_band(ux, uy, n_phi):
     return k % n_phi
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def inverse_mu(uz, mu_cut):
     amu = abs(uz)
     return 1.0 / amu if amu >= mu_cut else 2.0 / mu_cut
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def score_radiance(sc, grid, w_over_mu, ux, uy, uz):
     band = theta_band(uz, sc.theta_mu_edges)
     col = 0 if sc.theta_is_cap[band] else phi_band(ux, uy, sc.n_phi)
     grid[band, col] += w_over_mu
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def score_water(sc, flux, radiance, level, w, ux, uy, uz):
     w_over_mu = w * inverse_mu(uz, sc.mu_cut)
     if uz > 0.0:
@@ -58,14 +58,14 @@ def score_water(sc, flux, radiance, level, w, ux, uy, uz):
         score_radiance(sc, radiance[level], w_over_mu, ux, uy, uz)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz):
     air_flux[AIR_ED] += w
     if sc.tally_radiance:
         score_radiance(sc, air_radiance, w * inverse_mu(uz, sc.mu_cut), ux, uy, uz)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, water_leaving):
     air_flux[AIR_EU] += w
     if water_leaving:

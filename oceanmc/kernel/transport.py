@@ -8,6 +8,9 @@ that leaves the water is scored and ends, the other goes on) and at the bottom (
 rho_dh), exact exponential attenuation in layers that do not scatter, and unbiased Russian
 roulette below sc.roulette_weight. Analog mode decides each of these with a random draw instead.
 Either way every quantity has the same expectation; only the variance differs.
+
+Every function the loop calls is compiled with inline="always": the scene travels as one large
+named tuple, and a real call copies it (measured: 3x fewer photons/s without inlining).
 """
 import math
 
@@ -26,12 +29,12 @@ from .tally import score_air_down, score_air_up, score_water
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def exponential():
     return -math.log(1.0 - np.random.random())
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def survives_roulette(sc, w):
     """(alive, new weight): below the threshold a packet survives with probability p and then
     carries w/p, so the expected weight is unchanged."""
@@ -42,7 +45,7 @@ def survives_roulette(sc, w):
     return False, 0.0
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_lw, budget):
     """Follows one packet that arrives at the surface from the air; returns its scattering count."""
     score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz)
@@ -98,7 +101,8 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
                     absorbed = w * (a / c)
                     budget[BUDGET_LAYERS + layer] += absorbed
                     w -= absorbed
-                cos_s = phase.sample_cos(sc, layer, np.random.random(), np.random.random())
+                u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
+                cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
                 ux, uy, uz = turn(ux, uy, uz, cos_s, TWO_PI * np.random.random())
                 tau = exponential()
                 alive, w = survives_roulette(sc, w)
@@ -179,7 +183,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
             return events
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True)
 def trace_batch(sc, n_photons, seed, flux, radiance, air_flux, air_radiance, air_lw, budget):
     """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
     packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets

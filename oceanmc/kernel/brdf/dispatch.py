@@ -6,7 +6,7 @@ from ..models import BOTTOM_LAMBERTIAN, BOTTOM_MINNAERT, BOTTOM_SPECULAR
 from . import lambertian, minnaert, specular
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def sample_local(model, params, wix, wiy, wiz, u1, u2):
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.sample(params, wix, wiy, wiz, u1, u2)
@@ -17,7 +17,7 @@ def sample_local(model, params, wix, wiy, wiz, u1, u2):
     return 0.0, 0.0, 1.0, 0.0  # black
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
@@ -28,7 +28,7 @@ def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.pdf(params, wix, wiy, wiz, wox, woy, woz)
@@ -39,7 +39,7 @@ def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def reflect(model, params, ux, uy, uz, u1, u2):
     """A photon travelling (ux, uy, uz), uz > 0, meets the bottom: returns the reflected travel
     direction (upward) and the weight factor. Local frame = (x, -y, -z) of the global one (a

@@ -6,7 +6,7 @@ from ..models import PHASE_HG, PHASE_ISOTROPIC, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def sample_component(model, params, tab_start, tab_len, tab_psi, tab_q, tab_cdf, u):
     if model == PHASE_HG:
         return henyey_greenstein.sample(params, u)
@@ -17,7 +17,7 @@ def sample_component(model, params, tab_start, tab_len, tab_psi, tab_q, tab_cdf,
     return isotropic.sample(params, u)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def evaluate_component(model, params, tab_start, tab_len, tab_psi, tab_q, cos_psi):
     if model == PHASE_HG:
         return henyey_greenstein.evaluate(params, cos_psi)
@@ -28,7 +28,7 @@ def evaluate_component(model, params, tab_start, tab_len, tab_psi, tab_q, cos_ps
     return isotropic.evaluate(params, cos_psi)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def pick_component(sc, layer, u):
     """The component of the layer's mixture that scatters, chosen with probability b_k / b."""
     first = sc.layer_comp_start[layer]
@@ -39,8 +39,10 @@ def pick_component(sc, layer, u):
     return k
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def sample_cos(sc, layer, u_pick, u):
+    """cos(psi) from the layer's phase function; u_pick chooses the component of a mixture (it
+    is ignored for a single component, so the caller need not draw it), u the angle."""
     if sc.layer_comp_count[layer] == 1:
         k = sc.layer_comp_start[layer]
     else:
@@ -49,7 +51,7 @@ def sample_cos(sc, layer, u_pick, u):
                             sc.comp_tab_len[k], sc.tab_psi, sc.tab_q, sc.tab_cdf, u)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def evaluate(sc, layer, cos_psi):
     """The layer's phase function p(cos_psi) in 1/sr: the b-weighted sum of its components."""
     first = sc.layer_comp_start[layer]

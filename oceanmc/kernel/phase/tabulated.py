@@ -6,7 +6,7 @@ import math
 from numba import njit
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def sample(psi, q, cdf, start, length, u):
     lo = start
     hi = start + length - 1
@@ -26,7 +26,7 @@ def sample(psi, q, cdf, start, length, u):
     return math.cos(angle)
 
 
-@njit(cache=True)
+@njit(error_model="numpy", cache=True, inline="always")
 def evaluate(psi, q, start, length, cos_psi):
     angle = math.acos(min(1.0, max(-1.0, cos_psi)))
     lo = start
