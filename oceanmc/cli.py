@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
+import signal
 import sys
 import tempfile
 from pathlib import Path
@@ -31,12 +33,13 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
     return [target / f"{c.stem}.h5" for c in configs]
 
 
-def _check_writable(path: Path, overwrite: bool) -> None:
+def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0) -> None:
     """Fails before any photon is traced if the results file cannot be written."""
-    if path.exists() and not overwrite:
-        raise UsageError(f"{path} exists; pass --overwrite to replace it")
     if path.exists() and path.is_dir():
         raise UsageError(f"{path} is a folder, not a results file")
+    if path.exists() and not overwrite:
+        raise UsageError(f"{path} exists; pass --overwrite to replace it (or --resume to "
+                         "continue a partial run)")
     folder = path.parent if str(path.parent) else Path(".")
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -44,12 +47,48 @@ def _check_writable(path: Path, overwrite: bool) -> None:
             pass
     except OSError as exc:
         raise UsageError(f"cannot write results to {folder}: {exc.strerror or exc}") from None
+    free = shutil.disk_usage(folder).free
+    if free < 2 * need_bytes:
+        raise UsageError(f"not enough disk space in {folder}: about {need_bytes / 1e6:.1f} MB "
+                         f"needed, {free / 1e6:.1f} MB free")
+
+
+def _file_size_estimate(config) -> int:
+    """Bytes of a results file, roughly: every value is stored per batch, mean and stderr."""
+    n_theta = len(config.tallies.theta_edges) - 1
+    quad = n_theta * config.tallies.phi_bands if config.tallies.radiance else 0
+    per_batch = len(config.tallies.depths_m) * (6 + quad) + 3 * quad + \
+        len(config.water.layers) + 20
+    return 8 * per_batch * (config.batches + 2)
+
+
+class StopRequest:
+    """The first SIGINT or SIGTERM asks the run to stop after the batches in flight and write
+    what it has; the default handlers come back, so a second signal ends the process at once
+    (the atomic write means no results file is ever left half written)."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.signal_name = ""
+
+    def __call__(self, signum, frame) -> None:
+        self.requested = True
+        self.signal_name = signal.Signals(signum).name
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        print(f"\noceanmc: {self.signal_name}: finishing the batches in flight and writing the "
+              "photons done so far; press Ctrl-C again to quit at once", file=sys.stderr,
+              flush=True)
+
+    def install(self) -> None:
+        signal.signal(signal.SIGINT, self)
+        signal.signal(signal.SIGTERM, self)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .config import ConfigError, load_config
+    from .config import ConfigError, config_to_yaml, load_config
+    from .results import MergeError, format_summary, load_result, merge_results
     from .simulation import simulate
-    from .results import format_summary
 
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
@@ -60,22 +99,85 @@ def cmd_run(args: argparse.Namespace) -> int:
     scenes = []
     for path, out in zip(configs, outputs):
         try:
-            scenes.append(load_config(path, overrides))
+            config = load_config(path, overrides)
         except ConfigError as exc:
             print(f"oceanmc: config error: {exc}", file=sys.stderr)
             return 2
-        _check_writable(out, args.overwrite)
-    for path, out, config in zip(configs, outputs, scenes):
+        _check_writable(out, args.overwrite or (args.resume and out.exists()),
+                        _file_size_estimate(config))
+        previous = None
+        if args.resume and out.exists():
+            try:
+                previous = load_result(out)
+            except (OSError, KeyError, ValueError) as exc:
+                raise UsageError(f"--resume: {out} is not a results file ({exc})") from None
+            if not previous.attrs.get("partial", False):
+                raise UsageError(f"--resume: {out} is already complete "
+                                 f"({previous.attrs['batches']} batches)")
+            if previous.config_yaml != config_to_yaml(config):
+                raise UsageError(f"--resume: {out} was made from a different scene than {path} "
+                                 "(compare with `oceanmc show --config`)")
+        scenes.append((path, out, config, previous))
+
+    stop = StopRequest()
+    stop.install()
+    for path, out, config, previous in scenes:
+        first = 0
+        if previous is not None:
+            first = int(previous.attrs.get("first_batch", 0)) + int(previous.attrs["batches"])
+
+        def combined(result, previous=previous):
+            return result if previous is None else merge_results([previous, result], resume=True)
+
+        def checkpoint(partial, out=out, combined=combined):
+            combined(partial).save(out)
         try:
-            result = simulate(config, threads=args.threads, progress=not args.quiet)
+            result = simulate(config, threads=args.threads, progress=not args.quiet,
+                              first_batch=first, should_stop=lambda: stop.requested,
+                              on_checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every)
+            result = combined(result)
         except ConfigError as exc:  # auxiliary tables are read when the scene is built
             print(f"oceanmc: config error: {path}: {exc}", file=sys.stderr)
             return 2
+        except MergeError as exc:
+            raise UsageError(f"--resume: {exc}") from None
         result.attrs["config_file"] = str(path)
         result.save(out)
         print(format_summary(result))
         print(f"  wrote {out}")
+        if result.attrs.get("partial"):
+            total = config.batches
+            done = int(result.attrs["batches"])
+            print(f"  PARTIAL: {done} of {total} batches ({result.attrs['photons']:,} photons); "
+                  f"continue with: oceanmc run {path} -o {out} --resume")
         print()
+        if stop.requested:
+            print(f"oceanmc: stopped by {stop.signal_name}", file=sys.stderr)
+            return 130
+    return 0
+
+
+def cmd_merge(args: argparse.Namespace) -> int:
+    from .results import MergeError, format_summary, load_result, merge_results
+
+    out = Path(args.output)
+    parts = []
+    for name in args.files:
+        path = Path(name)
+        if not path.is_file():
+            raise UsageError(f"{path}: no such file")
+        try:
+            parts.append(load_result(path))
+        except (OSError, KeyError, ValueError) as exc:
+            raise UsageError(f"{path}: not an oceanmc results file ({exc})") from None
+    _check_writable(out, args.overwrite)
+    try:
+        merged = merge_results(parts)
+    except MergeError as exc:
+        raise UsageError(f"cannot merge: {exc}") from None
+    merged.save(out)
+    print(format_summary(merged))
+    print(f"  merged {len(parts)} runs (seeds {merged.attrs['seeds']}) into {out}")
     return 0
 
 
@@ -119,7 +221,17 @@ def build_parser() -> argparse.ArgumentParser:
                      help="threads (default: all cores); results do not depend on it")
     run.add_argument("--overwrite", action="store_true", help="replace existing results files")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    run.add_argument("--resume", action="store_true",
+                     help="continue the partial results file at the output path")
+    run.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+                     help="write the batches done so far this often (default 60 s)")
     run.set_defaults(func=cmd_run)
+
+    merge = sub.add_parser("merge", help="combine independent runs of one scene (other seeds)")
+    merge.add_argument("files", nargs="+", metavar="RESULT.h5")
+    merge.add_argument("-o", "--output", required=True, metavar="OUT.h5")
+    merge.add_argument("--overwrite", action="store_true", help="replace an existing OUT.h5")
+    merge.set_defaults(func=cmd_merge)
 
     validate = sub.add_parser("validate", help="run the validation suite and write its report")
     validate.add_argument("-o", "--output", default="validation", metavar="DIR",

@@ -35,6 +35,8 @@ class Quantity:
     @property
     def stderr(self) -> np.ndarray:
         n = self.batches.shape[0]
+        if n < 2:
+            return np.full(self.batches.shape[1:], np.nan)
         return self.batches.std(axis=0, ddof=1) / math.sqrt(n)
 
 
@@ -59,6 +61,80 @@ class Result:
 
     def save(self, path: str | Path) -> Path:
         return save_result(self, path)
+
+
+# --- merging ------------------------------------------------------------------------------------
+
+class MergeError(ValueError):
+    """Results that cannot be combined; the message says why."""
+
+
+def _scene_without(config_yaml: str, *keys: str) -> dict:
+    import yaml
+    scene = yaml.safe_load(config_yaml)
+    for key in keys:
+        scene.pop(key, None)
+    return scene
+
+
+def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
+    """One Result from several runs of the same scene, by concatenating their batches (the
+    standard errors then come from all batches together).
+
+    Independent runs (resume=False) must differ in seed and agree on everything else but the
+    photon count; photons per batch must match so that the batches are alike. A resumed run
+    (resume=True) continues the batches of the same seed: the scenes must be identical and the
+    batch ranges contiguous."""
+    if len(parts) < 2:
+        raise MergeError("need at least two results to merge")
+    first = parts[0]
+    if resume:
+        for part in parts[1:]:
+            if part.config_yaml != first.config_yaml:
+                raise MergeError("the stored scene differs from the one being resumed")
+        expected = int(first.attrs.get("first_batch", 0))
+        for i, part in enumerate(parts):
+            if int(part.attrs.get("first_batch", 0)) != expected:
+                raise MergeError(f"result {i + 1} starts at batch {part.attrs.get('first_batch')}"
+                                 f", expected {expected}")
+            expected += int(part.attrs["batches"])
+    else:
+        scene = _scene_without(first.config_yaml, "seed", "photons", "name")
+        seeds = []
+        for i, part in enumerate(parts):
+            if _scene_without(part.config_yaml, "seed", "photons", "name") != scene:
+                raise MergeError(f"result {i + 1} is a different scene (its water, surface, "
+                                 "bottom, illumination, tallies or estimator differ)")
+            if part.attrs.get("photons_per_batch") != first.attrs.get("photons_per_batch"):
+                raise MergeError(f"result {i + 1} has {part.attrs.get('photons_per_batch')} "
+                                 f"photons per batch, result 1 has "
+                                 f"{first.attrs.get('photons_per_batch')}: batches must be alike")
+            part_seeds = str(part.attrs.get("seeds", part.attrs["seed"])).split(",")
+            repeated = set(seeds) & set(part_seeds)
+            if repeated:
+                raise MergeError(f"seed {sorted(repeated)[0]} appears twice: runs with the same "
+                                 "seed are the same photons, not independent ones")
+            seeds += part_seeds
+        if set(first.quantities) != set().union(*(p.quantities for p in parts)):
+            raise MergeError("the results hold different quantities")
+    quantities = {
+        name: Quantity(name, q.dims, np.concatenate([p.quantities[name].batches for p in parts]),
+                       q.units, q.description)
+        for name, q in first.quantities.items()
+    }
+    attrs = dict(first.attrs)
+    for key in ("photons", "batches", "scattering_events"):
+        attrs[key] = sum(int(p.attrs[key]) for p in parts)
+    for key in ("wall_time_s", "startup_time_s"):
+        attrs[key] = sum(float(p.attrs[key]) for p in parts)
+    attrs["photons_per_s"] = attrs["photons"] / attrs["wall_time_s"] \
+        if attrs["wall_time_s"] > 0 else float("inf")
+    attrs["partial"] = bool(parts[-1].attrs.get("partial", False)) if resume else \
+        any(bool(p.attrs.get("partial", False)) for p in parts)
+    if not resume:
+        attrs["seeds"] = ",".join(seeds)
+        attrs["merged_from"] = len(parts)
+    return Result(dict(first.coords), quantities, attrs)
 
 
 # --- building a Result from raw kernel tallies ------------------------------------------------
@@ -179,6 +255,9 @@ def save_result(result: Result, path: str | Path) -> Path:
     try:
         with h5py.File(tmp, "w") as f:
             _write(f, result)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 is for the temporary name only
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

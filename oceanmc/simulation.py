@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numba
 import numpy as np
@@ -55,19 +55,30 @@ def _run(sc, n_per_batch: int, seeds: np.ndarray, raw: dict, lo: int, hi: int) -
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
-             progress: bool = False) -> Result:
-    """Runs a scene (a SceneConfig, a dict or a YAML path) and returns its Result."""
+             progress: bool = False, first_batch: int = 0,
+             should_stop: Callable[[], bool] | None = None,
+             on_checkpoint: Callable[[Result], None] | None = None,
+             checkpoint_every_s: float = 60.0) -> Result:
+    """Runs a scene (a SceneConfig, a dict or a YAML path) and returns its Result.
+
+    Batches first_batch .. batches-1 are traced (a resumed run starts after the batches it
+    already has; batch b is the same whatever the start). Between groups of batches,
+    should_stop() may end the run early: the Result then holds the batches completed and is
+    marked partial. on_checkpoint(result) receives the batches completed so far every
+    checkpoint_every_s seconds."""
     if not isinstance(config, SceneConfig):
         config = load_config(config)
     if threads is not None:
         numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     n_threads = numba.get_num_threads()
     sc, grid = scene.build(config)
-    n_batches = config.batches
-    n_per_batch = math.ceil(config.photons / n_batches)
+    if not 0 <= first_batch < config.batches:
+        raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
+    n_batches = config.batches - first_batch
+    n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
     depths = config.tallies.depths_m
-    seeds = batch_seeds(config.seed, n_batches)
+    seeds = batch_seeds(config.seed, config.batches)[first_batch:]
     raw = allocate(sc, n_batches, len(depths), grid, n_layers)
 
     t0 = time.perf_counter()
@@ -75,30 +86,44 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     _run(sc, 1, seeds[:1], scratch, 0, 1)  # compiles (or loads the cache) outside the timing
     startup = time.perf_counter() - t0
 
+    def result_of(done: int, wall: float) -> Result:
+        photons = done * n_per_batch
+        attrs = {
+            "name": config.name,
+            "config_yaml": config_to_yaml(config),
+            "oceanmc_version": __version__,
+            "numba_version": numba.__version__,
+            "seed": config.seed,
+            "photons": photons,
+            "batches": done,
+            "first_batch": first_batch,
+            "photons_per_batch": n_per_batch,
+            "partial": first_batch + done < config.batches,
+            "threads": n_threads,
+            "wall_time_s": wall,
+            "startup_time_s": startup,
+            "photons_per_s": photons / wall if wall > 0 else float("inf"),
+            "scattering_events": int(raw["events"][:done].sum()),
+        }
+        part = {name: values[:done] for name, values in raw.items()}
+        return from_tallies(part, grid, np.array(depths), n_per_batch,
+                            config.illumination.Ed0, n_layers, sc.tally_radiance, attrs)
+
     group = max(1, n_threads)
-    t1 = time.perf_counter()
+    done = 0
+    t1 = last_checkpoint = time.perf_counter()
     with tqdm(total=n_batches * n_per_batch, unit="photon", unit_scale=True, delay=1.0,
               disable=not progress, desc=config.name[:40], leave=False) as bar:
-        for lo in range(0, n_batches, group):
-            hi = min(n_batches, lo + group)
-            _run(sc, n_per_batch, seeds, raw, lo, hi)
-            bar.update((hi - lo) * n_per_batch)
-    wall = time.perf_counter() - t1
-    photons = n_batches * n_per_batch
-    attrs = {
-        "name": config.name,
-        "config_yaml": config_to_yaml(config),
-        "oceanmc_version": __version__,
-        "numba_version": numba.__version__,
-        "seed": config.seed,
-        "photons": photons,
-        "batches": n_batches,
-        "photons_per_batch": n_per_batch,
-        "threads": n_threads,
-        "wall_time_s": wall,
-        "startup_time_s": startup,
-        "photons_per_s": photons / wall if wall > 0 else float("inf"),
-        "scattering_events": int(raw["events"].sum()),
-    }
-    return from_tallies(raw, grid, np.array(depths), n_per_batch, config.illumination.Ed0,
-                        n_layers, sc.tally_radiance, attrs)
+        while done < n_batches:
+            hi = min(n_batches, done + group)
+            _run(sc, n_per_batch, seeds, raw, done, hi)
+            bar.update((hi - done) * n_per_batch)
+            done = hi
+            if should_stop is not None and should_stop():
+                break
+            now = time.perf_counter()
+            if on_checkpoint is not None and done < n_batches \
+                    and now - last_checkpoint >= checkpoint_every_s:
+                on_checkpoint(result_of(done, now - t1))
+                last_checkpoint = now
+    return result_of(done, time.perf_counter() - t1)
