@@ -145,7 +145,7 @@ class Water(_Strict):
 
     @property
     def depth_m(self) -> float:
-        return float(sum(layer.thickness_m for layer in self.layers))
+        return math.fsum(layer.thickness_m for layer in self.layers)
 
 
 # --- illumination, surface, bottom -----------------------------------------------------------
@@ -268,7 +268,7 @@ class SceneConfig(_Strict):
                              "(black, lambertian, minnaert, specular)")
         depth = self.water.depth_m
         for d in self.tallies.depths_m:
-            if d > depth:
+            if d > depth * (1.0 + 1e-12):
                 raise ValueError(f"tallies.depths_m contains {d} m, below the bottom at "
                                  f"{depth} m; allowed: 0 <= depth <= {depth}")
         if self.photons < self.batches:

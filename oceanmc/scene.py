@@ -89,7 +89,13 @@ def _planes(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray
     bounds = [0.0]
     for layer in config.water.layers:
         bounds.append(bounds[-1] + layer.thickness_m)
-    depths = config.tallies.depths_m
+    # a tally depth that differs from a layer boundary only by rounding (the sum of many thin
+    # layers) is that boundary, not a sliver of a segment beside it
+    edges = np.array(bounds)
+    depths = []
+    for d in config.tallies.depths_m:
+        near = int(np.argmin(np.abs(edges - d)))
+        depths.append(bounds[near] if abs(edges[near] - d) <= 1e-9 * max(1.0, d) else d)
     plane_z = np.array(sorted(set(bounds) | set(depths)), dtype=np.float64)
     level_of = {d: i for i, d in enumerate(depths)}
     plane_tally = np.array([level_of.get(z, -1) for z in plane_z], dtype=np.int64)
