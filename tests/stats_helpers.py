@@ -20,17 +20,21 @@ Z_SINGLE = 4.0   # |z| bound for one compared quantity
 
 # --- z-scores ---------------------------------------------------------------------------------
 
-def z_bound(n_compared: int, z_single: float = Z_SINGLE) -> float:
+def z_bound(n_compared: int, z_single: float = Z_SINGLE, dof: int | None = None) -> float:
     """The |z| bound that keeps the family-wise two-sided false-alarm probability of n_compared
-    independent z-tests equal to that of one test at z_single (Bonferroni)."""
+    independent z-tests equal to that of one normal test at z_single (Bonferroni). When the
+    standard error is itself estimated from few batches, z follows Student's t with dof =
+    batches - 1 degrees of freedom (heavier tails), and the bound is taken from it."""
     n = max(1, int(n_compared))
     p_single = 2.0 * stats.norm.sf(z_single)
-    return float(stats.norm.isf(0.5 * p_single / n))
+    if dof is None:
+        return float(stats.norm.isf(0.5 * p_single / n))
+    return float(stats.t.isf(0.5 * p_single / n, dof))
 
 
 def zscores(estimate, reference, stderr) -> np.ndarray:
     """(estimate - reference) / stderr, elementwise. A zero standard error (an estimate without
-    noise, e.g. exact weights) gives z = 0 where the estimate equals the reference to 1e-9
+    noise, e.g. exact weights; or one at the level of rounding) gives z = 0 where the estimate equals the reference to 1e-9
     relative (rounding in the tally sums) and +-inf otherwise."""
     est = np.asarray(estimate, dtype=np.float64)
     ref = np.asarray(reference, dtype=np.float64)
@@ -38,20 +42,22 @@ def zscores(estimate, reference, stderr) -> np.ndarray:
     est, ref, se = np.broadcast_arrays(est, ref, se)
     diff = est - ref
     z = np.zeros(est.shape)
-    noisy = se > 0.0
+    # a standard error at the level of rounding in the batch sums counts as none
+    noisy = se > 1e-12 * np.maximum(np.abs(ref), np.abs(est))
     z[noisy] = diff[noisy] / se[noisy]
     exact = ~noisy
     tol = 1e-9 * np.maximum(np.abs(ref[exact]), 1e-300)
-    z[exact] = np.where(np.abs(diff[exact]) <= tol, 0.0, np.sign(diff[exact]) * np.inf)
+    z[exact] = np.where(np.abs(diff[exact]) <= tol, 0.0, np.copysign(np.inf, diff[exact]))
     return z
 
 
 def assert_z(estimate, reference, stderr, *, rel_max: float | None = None,
              abs_max: float | None = None, n_compared: int | None = None,
-             z_single: float = Z_SINGLE, what: str = "") -> np.ndarray:
+             z_single: float = Z_SINGLE, dof: int | None = None, what: str = "") -> np.ndarray:
     """Asserts |z| below the Bonferroni bound for the number of compared values (by default the
     number of elements), and |estimate - reference| <= rel_max |reference| (or <= abs_max where
-    given, for references near 0). Returns the z-scores (for reporting)."""
+    given, for references near 0). dof: degrees of freedom of a batch standard error (batches - 1;
+    see z_bound). Returns the z-scores (for reporting)."""
     est = np.atleast_1d(np.asarray(estimate, dtype=np.float64))
     ref = np.broadcast_to(np.asarray(reference, dtype=np.float64), est.shape)
     se = np.broadcast_to(np.asarray(stderr, dtype=np.float64), est.shape)
@@ -59,7 +65,7 @@ def assert_z(estimate, reference, stderr, *, rel_max: float | None = None,
     assert np.all(np.isfinite(se)), f"{what}: non-finite standard error {se}"
     z = zscores(est, ref, se)
     n = est.size if n_compared is None else n_compared
-    bound = z_bound(n, z_single)
+    bound = z_bound(n, z_single, dof)
     worst = int(np.argmax(np.abs(z)))
     assert np.all(np.abs(z) < bound), (
         f"{what}: |z| = {abs(z.flat[worst]):.2f} >= {bound:.2f} (over {n} values) at index "
@@ -88,6 +94,11 @@ def assert_same(a, se_a, b, se_b, **kwargs) -> np.ndarray:
     the relative cap is taken against b."""
     se = np.sqrt(np.asarray(se_a, dtype=np.float64) ** 2 + np.asarray(se_b, dtype=np.float64) ** 2)
     return assert_z(a, b, se, **kwargs)
+
+
+def dof_of(result) -> int:
+    """Degrees of freedom of a Result's batch standard errors."""
+    return int(result.attrs["batches"]) - 1
 
 
 def batch_mean_se(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,11 +153,12 @@ def chi2_gof(observed, probabilities, *, min_expected: float = 20.0) -> tuple[fl
 
 
 def assert_chi2(observed, probabilities, *, p_min: float = 1e-4, rel_cap: float = 0.05,
-                min_cap_count: float = 2000.0, min_expected: float = 20.0,
+                min_cap_count: float = 10000.0, min_expected: float = 20.0,
                 what: str = "") -> tuple[float, int, float]:
     """Chi-square goodness of fit (p-value above p_min) plus a power check: every cell expected
     to hold at least min_cap_count samples must match within rel_cap, and there must be such
-    cells (so that too few samples cannot pass); cells of zero probability must be empty."""
+    cells (so that too few samples cannot pass); cells of zero probability must be empty.
+    rel_cap=None skips the power check (for a fine histogram whose marginals get it)."""
     observed = np.asarray(observed, dtype=np.float64).ravel()
     probabilities = np.asarray(probabilities, dtype=np.float64).ravel()
     n = observed.sum()
@@ -156,6 +168,8 @@ def assert_chi2(observed, probabilities, *, p_min: float = 1e-4, rel_cap: float 
     stat, dof, p = chi2_gof(observed, probabilities, min_expected=min_expected)
     assert dof >= 5, f"{what}: only {dof} degrees of freedom; the test has no power"
     assert p > p_min, f"{what}: chi-square {stat:.1f} on {dof} dof, p = {p:.2e} < {p_min:g}"
+    if rel_cap is None:
+        return stat, dof, p
     expected = n * probabilities
     big = expected >= min_cap_count
     assert big.any(), f"{what}: no cell expects {min_cap_count} samples; use more samples"
