@@ -173,19 +173,23 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
         q[name] = Quantity(name, dims, np.ascontiguousarray(values, dtype=np.float64), units,
                            description)
 
-    flux = raw["flux"] * scale
+    n_depths = len(depths)
+    flux = raw["flux"][:, :n_depths] * scale
     add("Ed", ("depth",), flux[:, :, models.FLUX_ED], IRR_UNITS, "downward plane irradiance")
     add("Eu", ("depth",), flux[:, :, models.FLUX_EU], IRR_UNITS, "upward plane irradiance")
     add("Eod", ("depth",), flux[:, :, models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance")
     add("Eou", ("depth",), flux[:, :, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance")
     add("Eo", ("depth",), flux[:, :, models.FLUX_EOD] + flux[:, :, models.FLUX_EOU], IRR_UNITS,
         "scalar irradiance Eod + Eou")
-    air = raw["air_flux"] * scale
-    add("air/Ed", (), air[:, models.AIR_ED], IRR_UNITS,
+    air = raw["flux"][:, n_depths] * scale
+    leaving = raw["flux"][:, n_depths + 1] * scale
+    add("air/Ed", (), air[:, models.FLUX_ED], IRR_UNITS,
         "downward plane irradiance just above the surface (0+): sun and sky")
-    add("air/Eu", (), air[:, models.AIR_EU], IRR_UNITS,
+    add("air/Eu", (), air[:, models.FLUX_EU], IRR_UNITS,
         "upward plane irradiance at 0+: surface-reflected plus water-leaving")
-    add("air/Eu_water_leaving", (), air[:, models.AIR_EU_WATER_LEAVING], IRR_UNITS,
+    add("air/Eod", (), air[:, models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance at 0+")
+    add("air/Eou", (), air[:, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
+    add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
         "upward plane irradiance at 0+ from light transmitted out of the water only")
     if radiance:
         def per_quad(values):
@@ -194,13 +198,14 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             out[..., caps, :] = out[..., caps, :1]  # a cap's one value in every phi column
             return out
         rad = per_quad(raw["radiance"])
-        add("radiance", ("depth", "theta", "phi"), rad, RAD_UNITS,
+        water_rad = rad[:, :n_depths]
+        air_rad = rad[:, n_depths]
+        lw = rad[:, n_depths + 1]
+        add("radiance", ("depth", "theta", "phi"), water_rad, RAD_UNITS,
             "radiance on the (theta, phi) quads, quad average; theta from nadir of the direction "
             "of travel, phi from the sun's travel azimuth")
-        add("Lu", ("depth",), rad[:, :, -1, 0], RAD_UNITS,
+        add("Lu", ("depth",), water_rad[:, :, -1, 0], RAD_UNITS,
             "nadir-viewing radiance (upward travel), the polar-cap quad average")
-        air_rad = per_quad(raw["air_radiance"])
-        lw = per_quad(raw["air_lw"])
         add("air/radiance", ("theta", "phi"), air_rad, RAD_UNITS,
             "radiance at 0+, all light: sun, sky, surface reflection, water-leaving")
         add("air/Lw", ("theta", "phi"), lw, RAD_UNITS,

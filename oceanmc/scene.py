@@ -184,6 +184,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         theta_mu_edges=_mu_edges(grid.theta_edges),
         theta_is_cap=grid.is_cap, n_phi=int(config.tallies.phi_bands),
         tally_radiance=bool(config.tallies.radiance), surface_tally=surface_tally,
+        air_level=len(config.tallies.depths_m),
         mu_cut=float(config.tallies.grazing_mu_cut),
         analog=config.estimator.mode == "analog",
         roulette_weight=float(config.estimator.roulette_weight),

@@ -36,13 +36,12 @@ def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
 
 
 def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str, np.ndarray]:
+    """Per-batch tally arrays; levels are the tally depths, then 0+ (all light), then 0+
+    (water-leaving light only)."""
     nt, npf = (len(grid.theta), len(grid.phi)) if sc.tally_radiance else (1, 1)
     return {
-        "flux": np.zeros((n_batches, n_depths, 4)),
-        "radiance": np.zeros((n_batches, n_depths, nt, npf)),
-        "air_flux": np.zeros((n_batches, 3)),
-        "air_radiance": np.zeros((n_batches, nt, npf)),
-        "air_lw": np.zeros((n_batches, nt, npf)),
+        "flux": np.zeros((n_batches, n_depths + 2, 4)),
+        "radiance": np.zeros((n_batches, n_depths + 2, nt, npf)),
         "budget": np.zeros((n_batches, len(budget_terms(n_layers)))),
         "events": np.zeros(n_batches, dtype=np.int64),
     }
@@ -50,7 +49,6 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
 
 def _run(sc, n_per_batch: int, seeds: np.ndarray, raw: dict, lo: int, hi: int) -> None:
     run_batches(sc, n_per_batch, seeds[lo:hi], raw["flux"][lo:hi], raw["radiance"][lo:hi],
-                raw["air_flux"][lo:hi], raw["air_radiance"][lo:hi], raw["air_lw"][lo:hi],
                 raw["budget"][lo:hi], raw["events"][lo:hi])
 
 

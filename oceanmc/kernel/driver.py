@@ -7,8 +7,6 @@ from .transport import trace_batch
 
 
 @njit(parallel=True, error_model="numpy", cache=True)
-def run_batches(sc, n_photons, seeds, flux, radiance, air_flux, air_radiance, air_lw, budget,
-                events):
+def run_batches(sc, n_photons, seeds, flux, radiance, budget, events):
     for i in prange(seeds.shape[0]):
-        events[i] = trace_batch(sc, n_photons, seeds[i], flux[i], radiance[i], air_flux[i],
-                                air_radiance[i], air_lw[i], budget[i])
+        events[i] = trace_batch(sc, n_photons, seeds[i], flux[i], radiance[i], budget[i])

@@ -31,8 +31,3 @@ FLUX_ED = 0
 FLUX_EU = 1
 FLUX_EOD = 2
 FLUX_EOU = 3
-
-# Air (0+) flux tally columns.
-AIR_ED = 0
-AIR_EU = 1
-AIR_EU_WATER_LEAVING = 2

@@ -19,7 +19,8 @@ SceneArrays = namedtuple("SceneArrays", [
     # bottom
     "bottom_model", "bottom_params",
     # tallies
-    "theta_mu_edges", "theta_is_cap", "n_phi", "tally_radiance", "surface_tally", "mu_cut",
+    "theta_mu_edges", "theta_is_cap", "n_phi", "tally_radiance", "surface_tally", "air_level",
+    "mu_cut",
     # estimator
     "analog", "roulette_weight", "roulette_survival", "max_events",
 ])

@@ -2,12 +2,16 @@
 to Ed or Eu, w/|mu| to Eod or Eou and to the radiance of its quad (normalised by the quad's solid
 angle and the photon count later, in results.py). Grazing crossings use the surface-flux rule:
 1/|mu| is replaced by 2/mu_cut when |mu| < mu_cut, which is exact when the radiance is constant
-over |mu| < mu_cut and keeps the variance finite (MCNP manual, F2 surface flux tally)."""
+over |mu| < mu_cut and keeps the variance finite (MCNP manual, F2 surface flux tally).
+
+Levels: the in-water tally depths first, then sc.air_level (0+, all light) and sc.air_level + 1
+(0+, water-leaving light only). Arrays are indexed, never sliced, in the loop: a view costs a
+reference-count update."""
 import math
 
 from numba import njit
 
-from .models import AIR_ED, AIR_EU, AIR_EU_WATER_LEAVING, FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
+from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
 @njit(error_model="numpy", cache=True, inline="always")
@@ -39,14 +43,8 @@ def inverse_mu(uz, mu_cut):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score_radiance(sc, grid, w_over_mu, ux, uy, uz):
-    band = theta_band(uz, sc.theta_mu_edges)
-    col = 0 if sc.theta_is_cap[band] else phi_band(ux, uy, sc.n_phi)
-    grid[band, col] += w_over_mu
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def score_water(sc, flux, radiance, level, w, ux, uy, uz):
+def score(sc, flux, radiance, level, w, ux, uy, uz):
+    """A crossing of tally level `level` (an in-water depth, or the air levels after them)."""
     w_over_mu = w * inverse_mu(uz, sc.mu_cut)
     if uz > 0.0:
         flux[level, FLUX_ED] += w
@@ -55,23 +53,15 @@ def score_water(sc, flux, radiance, level, w, ux, uy, uz):
         flux[level, FLUX_EU] += w
         flux[level, FLUX_EOU] += w_over_mu
     if sc.tally_radiance:
-        score_radiance(sc, radiance[level], w_over_mu, ux, uy, uz)
+        band = theta_band(uz, sc.theta_mu_edges)
+        col = 0 if sc.theta_is_cap[band] else phi_band(ux, uy, sc.n_phi)
+        radiance[level, band, col] += w_over_mu
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz):
-    air_flux[AIR_ED] += w
-    if sc.tally_radiance:
-        score_radiance(sc, air_radiance, w * inverse_mu(uz, sc.mu_cut), ux, uy, uz)
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, water_leaving):
-    air_flux[AIR_EU] += w
+def score_air_up(sc, flux, radiance, w, ux, uy, uz, water_leaving):
+    """Light travelling up at 0+: all of it at sc.air_level, and what came out of the water also
+    at the water-leaving level after it."""
+    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz)
     if water_leaving:
-        air_flux[AIR_EU_WATER_LEAVING] += w
-    if sc.tally_radiance:
-        w_over_mu = w * inverse_mu(uz, sc.mu_cut)
-        score_radiance(sc, air_radiance, w_over_mu, ux, uy, uz)
-        if water_leaving:
-            score_radiance(sc, air_lw, w_over_mu, ux, uy, uz)
+        score(sc, flux, radiance, sc.air_level + 1, w, ux, uy, uz)

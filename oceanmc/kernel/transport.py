@@ -24,7 +24,7 @@ from .models import (BOTTOM_BLACK, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BEL
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
 from .phase import dispatch as phase
 from .sources import sky_cosine
-from .tally import score_air_down, score_air_up, score_water
+from .tally import score, score_air_up
 
 TWO_PI = 2.0 * math.pi
 
@@ -46,25 +46,25 @@ def survives_roulette(sc, w):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_lw, budget):
+def trace_photon(sc, w, ux, uy, uz, flux, radiance, budget):
     """Follows one packet that arrives at the surface from the air; returns its scattering count."""
-    score_air_down(sc, air_flux, air_radiance, w, ux, uy, uz)
+    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz)
     n = sc.n_water
     if sc.surface_flat:
         r, cos_t = reflectance(sc, 1.0, n, uz)
         if sc.analog:
             if np.random.random() < r:
-                score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, -uz, False)
+                score_air_up(sc, flux, radiance, w, ux, uy, -uz, False)
                 budget[BUDGET_SURFACE_REFLECTION] += w
                 return 0
         else:
             if r > 0.0:
-                score_air_up(sc, air_flux, air_radiance, air_lw, w * r, ux, uy, -uz, False)
+                score_air_up(sc, flux, radiance, w * r, ux, uy, -uz, False)
                 budget[BUDGET_SURFACE_REFLECTION] += w * r
             w *= 1.0 - r
         ux, uy, uz = refract(ux, uy, uz, 1.0 / n, cos_t)
     if sc.surface_tally >= 0:
-        score_water(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz)
+        score(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz)
 
     plane_z = sc.plane_z
     bottom_plane = plane_z.shape[0] - 1
@@ -133,32 +133,32 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
         z = plane_z[target]
         level = sc.plane_tally[target]
         if level >= 0:
-            score_water(sc, flux, radiance, level, w, ux, uy, uz)
+            score(sc, flux, radiance, level, w, ux, uy, uz)
 
         if target == 0:
             # at the surface from below
             if not sc.surface_flat:
-                score_air_up(sc, air_flux, air_radiance, air_lw, w, ux, uy, uz, True)
+                score_air_up(sc, flux, radiance, w, ux, uy, uz, True)
                 budget[BUDGET_WATER_LEAVING] += w
                 return events
             r, cos_t = reflectance(sc, n, 1.0, -uz)
             if sc.analog:
                 if np.random.random() >= r:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, air_flux, air_radiance, air_lw, w, ox, oy, oz, True)
+                    score_air_up(sc, flux, radiance, w, ox, oy, oz, True)
                     budget[BUDGET_WATER_LEAVING] += w
                     return events
             else:
                 leaving = w * (1.0 - r)
                 if leaving > 0.0:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, air_flux, air_radiance, air_lw, leaving, ox, oy, oz, True)
+                    score_air_up(sc, flux, radiance, leaving, ox, oy, oz, True)
                     budget[BUDGET_WATER_LEAVING] += leaving
                 w *= r
             uz = -uz
             seg = 0
             if level >= 0 and w > 0.0:
-                score_water(sc, flux, radiance, level, w, ux, uy, uz)
+                score(sc, flux, radiance, level, w, ux, uy, uz)
         elif target == bottom_plane:
             if sc.bottom_model == BOTTOM_BLACK:
                 budget[BUDGET_BOTTOM] += w
@@ -174,7 +174,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
                 w *= rho
             seg = bottom_plane - 1
             if level >= 0 and w > 0.0:
-                score_water(sc, flux, radiance, level, w, ux, uy, uz)
+                score(sc, flux, radiance, level, w, ux, uy, uz)
         else:
             seg = target if uz > 0.0 else target - 1
             continue
@@ -184,7 +184,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance, air_
 
 
 @njit(error_model="numpy", cache=True)
-def trace_batch(sc, n_photons, seed, flux, radiance, air_flux, air_radiance, air_lw, budget):
+def trace_batch(sc, n_photons, seed, flux, radiance, budget):
     """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
     packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
     come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
@@ -207,6 +207,5 @@ def trace_batch(sc, n_photons, seed, flux, radiance, air_flux, air_radiance, air
         else:
             ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
             w = w_sun
-        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, air_flux, air_radiance,
-                               air_lw, budget)
+        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, budget)
     return events

@@ -29,6 +29,13 @@ def evaluate_component(model, params, tab_start, tab_len, tab_psi, tab_q, cos_ps
 
 
 @njit(error_model="numpy", cache=True, inline="always")
+def component_params(sc, k):
+    """The component's parameters as a tuple of floats: a row view of the 2-D array would cost
+    a reference-count update per scattering event."""
+    return (sc.comp_params[k, 0], sc.comp_params[k, 1])
+
+
+@njit(error_model="numpy", cache=True, inline="always")
 def pick_component(sc, layer, u):
     """The component of the layer's mixture that scatters, chosen with probability b_k / b."""
     first = sc.layer_comp_start[layer]
@@ -47,7 +54,7 @@ def sample_cos(sc, layer, u_pick, u):
         k = sc.layer_comp_start[layer]
     else:
         k = pick_component(sc, layer, u_pick)
-    return sample_component(sc.comp_model[k], sc.comp_params[k], sc.comp_tab_start[k],
+    return sample_component(sc.comp_model[k], component_params(sc, k), sc.comp_tab_start[k],
                             sc.comp_tab_len[k], sc.tab_psi, sc.tab_q, sc.tab_cdf, u)
 
 
@@ -60,7 +67,7 @@ def evaluate(sc, layer, cos_psi):
     for k in range(first, first + sc.layer_comp_count[layer]):
         weight = sc.comp_cumweight[k] - previous
         previous = sc.comp_cumweight[k]
-        total += weight * evaluate_component(sc.comp_model[k], sc.comp_params[k],
+        total += weight * evaluate_component(sc.comp_model[k], component_params(sc, k),
                                              sc.comp_tab_start[k], sc.comp_tab_len[k],
                                              sc.tab_psi, sc.tab_q, cos_psi)
     return total
