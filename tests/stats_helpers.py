@@ -168,6 +168,7 @@ def assert_chi2(observed, probabilities, *, p_min: float = 1e-4, rel_cap: float 
     stat, dof, p = chi2_gof(observed, probabilities, min_expected=min_expected)
     assert dof >= 5, f"{what}: only {dof} degrees of freedom; the test has no power"
     assert p > p_min, f"{what}: chi-square {stat:.1f} on {dof} dof, p = {p:.2e} < {p_min:g}"
+    print(f"{what}: chi-square {stat:.1f} on {dof} dof, p = {p:.3f}")
     if rel_cap is None:
         return stat, dof, p
     expected = n * probabilities

@@ -385,6 +385,7 @@ def test_snells_window():
     zr(r, r["air/Eu"], r_aw, r.stderr("air/Eu"), rel_max=0.01, what="air/Eu")
     assert r["air/Ed"] == pytest.approx(1.0, rel=1e-12)
     assert r["air/Eu_water_leaving"] == 0.0
+    assert np.all(r["air/Lw"] == 0.0)   # all the upward light at 0+ is sky reflection
     # above the surface: the sky itself and its reflection
     sky_ref = radiance_band_reference(r, lambda m: L, upward=False)
     compare_radiance(r, "air/radiance", None, sky_ref, False, quad_rel_max=0.15,
@@ -420,7 +421,7 @@ def test_water_to_air_reflectance():
     radiance just below the surface: uniform upward, L_up = T / (pi (1 - r_wa)); downward
     outside Snell's window equal to it (total internal reflection), inside R(theta) L_up."""
     sun = 30.0
-    r = simulate({"photons": 400_000, "batches": 32, "seed": 8,
+    r = simulate({"photons": 1_000_000, "batches": 32, "seed": 8,
                   "illumination": {"Ed0": 1.0, "sun_zenith_deg": sun},
                   "surface": {"model": "flat", "n_water": N},
                   "water": {"layers": [{"thickness_m": 1e-3, "a": 0.0, "b": 0.0}]},
@@ -453,12 +454,22 @@ def test_water_to_air_reflectance():
     sun_quad[sun_band, 0] = True
     zd = compare_radiance(r, "radiance", 0, ref, False, quad_rel_max=0.2, band_rel_max=0.02,
                           edge_rel_max=0.5, exclude=sun_quad, what="reflected-down L(0-)")
+    # above the surface the water-leaving radiance obeys the n^2 law the other way:
+    # Lw(theta_air) = (1 - R(theta_air)) L_up / n^2, uniform L_up below
+    lw = radiance_band_reference(
+        r, lambda m: (1.0 - fresnel_reference(1.0, N, math.acos(m))) * l_up / N ** 2, upward=True)
+    zw = compare_radiance(r, "air/Lw", None, lw, True, quad_rel_max=0.2, band_rel_max=0.02,
+                          edge_rel_max=0.5, what="water-leaving Lw(0+)")
+    zr(r, r["air/Lw_nadir"], lw[-1, 0], r.stderr("air/Lw_nadir"), rel_max=0.05, what="Lw nadir")
+    assert r["air/Rrs_nadir"] == pytest.approx(r["air/Lw_nadir"], rel=1e-12)
+    assert r["air/Eu_water_leaving"] == pytest.approx(r["budget/water_leaving"], rel=1e-12)
     tir = np.where(hi[:10] <= MU_C)[0]
     band_mean, band_se = batch_mean_se(r.quantities["radiance"].batches[:, 0, tir, :]
                                        .mean(axis=2))
     zr(r, band_mean, l_up, band_se, rel_max=0.01, what="TIR bands = L_up")
     print(f"r_wa = {est:.5f} +- {se:.5f} (ref {r_wa_ref:.5f}, z {float(z[0]):.2f}); "
-          f"max |z| down quads {zd:.2f}")
+          f"max |z| down quads {zd:.2f}, Lw quads {zw:.2f}; Lw nadir {r['air/Lw_nadir']:.5f} +- "
+          f"{r.stderr('air/Lw_nadir'):.5f} (ref {lw[-1, 0]:.5f})")
 
 
 # --- 8. Chandrasekhar: semi-infinite isotropic scattering --------------------------------------
