@@ -207,6 +207,11 @@ class Tallies(_Strict):
     theta_edges_deg: Literal["hydrolight"] | list[Finite] = "hydrolight"
     phi_bands: Annotated[int, Field(ge=1, le=360)] = 24
     radiance: bool = True
+    local_directions_deg: list[tuple[Annotated[float, Field(gt=90.0, le=180.0,
+                                                           allow_inf_nan=False)],
+                                     Annotated[float, Field(ge=0.0, lt=360.0,
+                                                           allow_inf_nan=False)]]] \
+        = Field(default_factory=list, max_length=64)
     grazing_mu_cut: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 0.01
 
     @field_validator("depths_m")
@@ -271,8 +276,13 @@ class SceneConfig(_Strict):
             if d > depth * (1.0 + 1e-12):
                 raise ValueError(f"tallies.depths_m contains {d} m, below the bottom at "
                                  f"{depth} m; allowed: 0 <= depth <= {depth}")
-        if self.photons < self.batches:
-            raise ValueError(f"photons = {self.photons} is fewer than batches = {self.batches}")
+        if self.photons < 2 * self.batches:
+            raise ValueError(f"photons = {self.photons}: need at least 2 per batch "
+                             f"(batches = {self.batches})")
+        if self.tallies.local_directions_deg and self.bottom.model == "specular":
+            raise ValueError("tallies.local_directions_deg with bottom.model = 'specular': a "
+                             "mirror has no density for a local estimate; use the quad "
+                             "radiances")
         return self
 
     @property

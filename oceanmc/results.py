@@ -162,9 +162,11 @@ def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
 
 
 def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_batch: int,
-                 ed0: float, n_layers: int, radiance: bool, attrs: dict) -> Result:
+                 ed0: float, n_layers: int, radiance: bool, attrs: dict,
+                 directions: list = (), local_rows: list = ()) -> Result:
     """Normalises raw per-batch weight sums (per launched photon, times Ed0; radiances also per
-    quad solid angle) and derives the contract's quantities."""
+    quad solid angle) and derives the contract's quantities. directions: the (theta, phi) of the
+    local estimates, local_rows: their (water row, air row) in raw["local"]."""
     scale = ed0 / n_per_batch
     omega = grid.solid_angle
     q: dict[str, Quantity] = {}
@@ -216,6 +218,35 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             "nadir water-leaving radiance at 0+, polar-cap quad average")
         add("air/Rrs_nadir", (), lw[:, -1, 0] / ed0, "sr-1",
             "remote-sensing reflectance Lw_nadir / Ed(0+)")
+    lu_method = "polar-cap quad average (theta 175-180 deg with HydroLight edges), crossing " \
+                "estimator"
+    if len(directions):
+        local = raw["local"] * scale
+        water_rows = [w for w, _ in local_rows]
+        air_rows = [a for _, a in local_rows]
+        add("local_radiance", ("depth", "direction"), local[:, :n_depths][:, :, water_rows],
+            RAD_UNITS, "radiance in the exact directions of local_directions_deg (theta, phi "
+            "of travel), local (next-event) estimate")
+        add("air/Lw_local", ("direction",), local[:, n_depths][:, air_rows], RAD_UNITS,
+            "water-leaving radiance at 0+ in the exact directions of local_directions_deg, "
+            "local (next-event) estimate")
+        add("air/Rrs_local", ("direction",), local[:, n_depths][:, air_rows] / ed0, "sr-1",
+            "Lw_local / Ed(0+)")
+        nadir = [i for i, (theta, _) in enumerate(directions) if theta == 180.0]
+        if nadir and radiance:
+            i = nadir[0]
+            for name, values in (("Lu", local[:, :n_depths, water_rows[i]]),
+                                 ("air/Lw_nadir", local[:, n_depths, air_rows[i]]),
+                                 ("air/Rrs_nadir", local[:, n_depths, air_rows[i]] / ed0)):
+                q[name + "_quad"] = q.pop(name)
+                q[name + "_quad"].name = name + "_quad"
+                q[name + "_quad"].description += " (crossing estimator)"
+                add(name, q[name + "_quad"].dims, values, q[name + "_quad"].units,
+                    q[name + "_quad"].description.replace(
+                        "polar-cap quad average", "exact nadir, local estimate").replace(
+                        " (crossing estimator)", ""))
+            lu_method = "exact nadir, local (next-event) estimate; the polar-cap quad " \
+                        "averages are in Lu_quad, air/Lw_nadir_quad, air/Rrs_nadir_quad"
     budget = raw["budget"] / n_per_batch
     for column, name, description in budget_terms(n_layers):
         add(f"budget/{name}", (), budget[:, column], "1", description)
@@ -225,10 +256,12 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
         "depth": np.asarray(depths, dtype=np.float64),
         "theta": grid.theta, "phi": grid.phi,
         "theta_edges": grid.theta_edges, "phi_edges": grid.phi_edges,
+        "direction": np.arange(len(directions)),
+        "direction_theta": np.array([d[0] for d in directions], dtype=np.float64),
+        "direction_phi": np.array([d[1] for d in directions], dtype=np.float64),
     }
     attrs = dict(attrs)
-    attrs.setdefault("Lu_method", "polar-cap quad average (theta 175-180 deg with HydroLight "
-                                  "edges), crossing estimator")
+    attrs["Lu_method"] = lu_method
     return Result(coords, q, attrs)
 
 
@@ -240,7 +273,13 @@ COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is
                "phi": ("deg", "azimuth of travel from the sun's travel azimuth, band centre"),
                "theta_edges": ("deg", "theta band edges"),
                "phi_edges": ("deg", "phi band edges"),
-               "batch": ("1", "independent batch index")}
+               "batch": ("1", "independent batch index"),
+               "direction": ("1", "index of a local-estimate direction"),
+               "direction_theta": ("deg", "theta of travel of each local-estimate direction"),
+               "direction_phi": ("deg", "phi of travel of each local-estimate direction")}
+
+
+AUXILIARY_COORDS = {"direction_theta": "direction", "direction_phi": "direction"}
 
 
 def _write_attrs(obj, attrs: dict) -> None:
@@ -297,8 +336,11 @@ def _write(f: h5py.File, result: Result) -> None:
             ds.dims[axis].attach_scale(scale(group, dim))
         return ds
 
-    for name in result.coords:
-        scale("", name)
+    for name, values in result.coords.items():
+        if name in AUXILIARY_COORDS:
+            write(name, values, (AUXILIARY_COORDS[name],), *COORD_UNITS[name])
+        else:
+            scale("", name)
     for q in result.quantities.values():
         write(q.name, q.mean, q.dims, q.units, q.description)
         write(q.name + "_stderr", q.stderr, q.dims, q.units,
@@ -314,8 +356,7 @@ def load_result(path: str | Path) -> Result:
     path = Path(path)
     with h5py.File(path, "r") as f:
         attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
-        coords = {name: f[name][()] for name in ("depth", "theta", "phi", "theta_edges",
-                                                 "phi_edges")}
+        coords = {name: f[name][()] for name in COORD_UNITS if name != "batch"}
         quantities = {}
 
         def visit(name, obj):

@@ -10,6 +10,7 @@ import numpy as np
 from . import config as cfg
 from . import phase_tables
 from .kernel import models
+from .kernel.interface import fresnel
 from .kernel.scene_arrays import SceneArrays
 
 PURE_WATER_BETA = 0.835   # 0.06225 (1 + 0.835 cos^2): Morel (1974)
@@ -83,9 +84,10 @@ def _phase_components(phase) -> list[tuple[float, int, list[float], tuple | None
     raise AssertionError(f"unhandled phase model {phase!r}")
 
 
-def _planes(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+def _planes(config: cfg.SceneConfig):
     """Plane depths (surface first, bottom or inf last), the tally level at each plane (-1 for
-    none), the layer of each segment between planes, and the level tallied at 0- (or -1)."""
+    none), the layer of each segment between planes, the level tallied at 0- (or -1), and the
+    tally depths (snapped onto layer boundaries they differ from only by rounding)."""
     bounds = [0.0]
     for layer in config.water.layers:
         bounds.append(bounds[-1] + layer.thickness_m)
@@ -102,7 +104,47 @@ def _planes(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray
     tops = np.array(bounds[:-1])
     mids = np.where(np.isinf(plane_z[1:]), plane_z[:-1] + 1.0, 0.5 * (plane_z[1:] + plane_z[:-1]))
     segment_layer = (np.searchsorted(tops, mids, side="right") - 1).astype(np.int64)
-    return plane_z, plane_tally, segment_layer, int(plane_tally[0])
+    return plane_z, plane_tally, segment_layer, int(plane_tally[0]), np.array(depths)
+
+
+def _optical_depths(plane_z: np.ndarray, segment_layer: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """tau = integral of c dz from the surface to each plane (inf below an infinite layer)."""
+    with np.errstate(invalid="ignore"):
+        steps = np.where(np.isinf(plane_z[1:]), np.inf,
+                         c[segment_layer] * (plane_z[1:] - plane_z[:-1]))
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def local_directions(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                         list[tuple[int, int]]]:
+    """Kernel rows for the requested local-estimate directions (theta, phi of travel; in water at
+    the tally depths, in air at 0+): unit in-water directions, whether a row scores the water
+    levels, its factor t/n^2 at 0+ (0: not scored there), and for each requested direction its
+    (water row, air row)."""
+    n = config.n_water
+    dirs, water, air, rows = [], [], [], []
+    for theta_deg, phi_deg in config.tallies.local_directions_deg:
+        theta, phi = math.radians(theta_deg), math.radians(phi_deg)
+        in_water = (math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi),
+                    math.cos(theta))
+        sin_w = math.sin(theta) / n               # Snell: the in-water direction seen at 0+
+        cos_w = math.sqrt(1.0 - sin_w * sin_w)
+        refracted = (sin_w * math.cos(phi), sin_w * math.sin(phi), -cos_w)
+        if config.surface.model == "flat":
+            r, _ = fresnel(n, 1.0, cos_w)
+            factor = (1.0 - r) / (n * n)
+        else:
+            factor = 1.0
+        if np.allclose(in_water, refracted, atol=1e-15):
+            rows.append((len(dirs), len(dirs)))
+            dirs.append(in_water), water.append(True), air.append(factor)
+        else:
+            rows.append((len(dirs), len(dirs) + 1))
+            dirs += [in_water, refracted]
+            water += [True, False]
+            air += [0.0, factor]
+    return (np.array(dirs, dtype=np.float64).reshape(-1, 3), np.array(water, dtype=np.bool_),
+            np.array(air, dtype=np.float64), rows)
 
 
 def _bottom(bottom) -> tuple[int, np.ndarray]:
@@ -158,7 +200,12 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
     def flat(parts):
         return np.concatenate(parts) if parts else np.zeros(1)
 
-    plane_z, plane_tally, segment_layer, surface_tally = _planes(config)
+    plane_z, plane_tally, segment_layer, surface_tally, depths = _planes(config)
+    layer_c = np.array([layer.a + layer.b for layer in layers], dtype=np.float64)
+    plane_tau = _optical_depths(plane_z, segment_layer, layer_c)
+    level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
+                         dtype=np.float64)
+    le_dirs, le_water, le_air_factor, _ = local_directions(config)
     bottom_model, bottom_params = _bottom(config.bottom)
     grid = make_grid(config.tallies)
     ill = config.illumination
@@ -186,6 +233,9 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         tally_radiance=bool(config.tallies.radiance), surface_tally=surface_tally,
         air_level=len(config.tallies.depths_m),
         mu_cut=float(config.tallies.grazing_mu_cut),
+        level_z=depths.astype(np.float64), level_tau=level_tau, plane_tau=plane_tau,
+        local_estimates=len(le_dirs) > 0, le_dirs=le_dirs, le_water=le_water,
+        le_air_factor=le_air_factor,
         analog=config.estimator.mode == "analog",
         roulette_weight=float(config.estimator.roulette_weight),
         roulette_survival=float(config.estimator.roulette_survival),

@@ -42,6 +42,7 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
     return {
         "flux": np.zeros((n_batches, n_depths + 2, 4)),
         "radiance": np.zeros((n_batches, n_depths + 2, nt, npf)),
+        "local": np.zeros((n_batches, n_depths + 1, sc.le_dirs.shape[0])),
         "budget": np.zeros((n_batches, len(budget_terms(n_layers)))),
         "events": np.zeros(n_batches, dtype=np.int64),
     }
@@ -49,7 +50,7 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
 
 def _run(sc, n_per_batch: int, seeds: np.ndarray, raw: dict, lo: int, hi: int) -> None:
     run_batches(sc, n_per_batch, seeds[lo:hi], raw["flux"][lo:hi], raw["radiance"][lo:hi],
-                raw["budget"][lo:hi], raw["events"][lo:hi])
+                raw["local"][lo:hi], raw["budget"][lo:hi], raw["events"][lo:hi])
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -77,6 +78,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_layers = len(config.water.layers)
     depths = config.tallies.depths_m
     seeds = batch_seeds(config.seed, config.batches)[first_batch:]
+    local_rows = scene.local_directions(config)[3]
     raw = allocate(sc, n_batches, len(depths), grid, n_layers)
 
     t0 = time.perf_counter()
@@ -105,7 +107,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         }
         part = {name: values[:done] for name, values in raw.items()}
         return from_tallies(part, grid, np.array(depths), n_per_batch,
-                            config.illumination.Ed0, n_layers, sc.tally_radiance, attrs)
+                            config.illumination.Ed0, n_layers, sc.tally_radiance, attrs,
+                            config.tallies.local_directions_deg, local_rows)
 
     group = max(1, n_threads)
     done = 0

@@ -17,6 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import local_estimate
 from .brdf import dispatch as brdf
 from .geometry import from_angles, turn
 from .interface import reflectance, refract
@@ -46,7 +47,7 @@ def survives_roulette(sc, w):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_photon(sc, w, ux, uy, uz, flux, radiance, budget):
+def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
     """Follows one packet that arrives at the surface from the air; returns its scattering count."""
     score(sc, flux, radiance, sc.air_level, w, ux, uy, uz)
     n = sc.n_water
@@ -93,6 +94,9 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, budget):
             if s < dist:
                 z += s * uz
                 events += 1
+                if sc.local_estimates:
+                    local_estimate.score_collision(sc, local, seg, layer, z, w * (b / c),
+                                                   ux, uy, uz)
                 if sc.analog:
                     if np.random.random() * c < a:
                         budget[BUDGET_LAYERS + layer] += w
@@ -163,6 +167,8 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, budget):
             if sc.bottom_model == BOTTOM_BLACK:
                 budget[BUDGET_BOTTOM] += w
                 return events
+            if sc.local_estimates:
+                local_estimate.score_bottom(sc, local, w, ux, uy, uz)
             ux, uy, uz, rho = brdf.reflect(sc.bottom_model, sc.bottom_params, ux, uy, uz,
                                            np.random.random(), np.random.random())
             if sc.analog:
@@ -184,7 +190,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, budget):
 
 
 @njit(error_model="numpy", cache=True)
-def trace_batch(sc, n_photons, seed, flux, radiance, budget):
+def trace_batch(sc, n_photons, seed, flux, radiance, local, budget):
     """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
     packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
     come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
@@ -207,5 +213,5 @@ def trace_batch(sc, n_photons, seed, flux, radiance, budget):
         else:
             ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
             w = w_sun
-        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, budget)
+        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget)
     return events

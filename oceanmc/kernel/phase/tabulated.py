@@ -5,6 +5,8 @@ import math
 
 from numba import njit
 
+EDGE = 1e-12
+
 
 @njit(error_model="numpy", cache=True, inline="always")
 def sample(psi, q, cdf, start, length, u):
@@ -28,7 +30,9 @@ def sample(psi, q, cdf, start, length, u):
 
 @njit(error_model="numpy", cache=True, inline="always")
 def evaluate(psi, q, start, length, cos_psi):
-    angle = math.acos(min(1.0, max(-1.0, cos_psi)))
+    """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
+    tends to a finite limit, taken by staying EDGE rad inside the range."""
+    angle = min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
     lo = start
     hi = start + length - 1
     while hi - lo > 1:
@@ -39,7 +43,4 @@ def evaluate(psi, q, start, length, cos_psi):
             hi = mid
     frac = (angle - psi[lo]) / (psi[lo + 1] - psi[lo])
     dens = q[lo] + frac * (q[lo + 1] - q[lo])
-    s = math.sin(angle)
-    if s <= 0.0:
-        return 0.0  # the density per solid angle at exactly 0 or pi is a limit; callers avoid it
-    return dens / (2.0 * math.pi * s)
+    return dens / (2.0 * math.pi * math.sin(angle))
