@@ -680,3 +680,15 @@ def test_white_mirror_bottom_terminates(mode, b):
     zr(r, out, 1.0, r.stderr("budget/total"), abs_max=1e-3, what="mirror: all light leaves")
     assert r["budget/absorbed_bottom"] == 0.0
     assert r["budget/absorbed_layer_1"] == 0.0
+
+
+def test_grazing_collimated_sun_scalar_irradiance_is_exact():
+    """The unscattered solar beam gets the exact 1/|mu| even below grazing_mu_cut: with the sun
+    at 89.9 deg and no interface, Eod = Ed0 / cos(89.9 deg) = 572.96 at 0+ and at 0-."""
+    r = oceanmc.simulate({"photons": 2000, "batches": 4,
+                          "illumination": {"sun_zenith_deg": 89.9}, "surface": {"model": "none"},
+                          "water": {"layers": [{"thickness_m": 1, "a": 0.0, "b": 0.0}]},
+                          "bottom": {"model": "black"}, "tallies": {"depths_m": [0]}})
+    expected = 1.0 / math.cos(math.radians(89.9))
+    assert r["air/Eod"] == pytest.approx(expected, rel=1e-9)
+    assert r["Eod"][0] == pytest.approx(expected, rel=1e-9)

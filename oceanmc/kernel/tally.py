@@ -37,15 +37,19 @@ def phi_band(ux, uy, n_phi):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def inverse_mu(uz, mu_cut):
+def inverse_mu(uz, mu_cut, beam):
+    """1/|mu|, or 2/mu_cut below the cut for diffuse light. A collimated beam (the unscattered
+    sun) always gets the exact 1/|mu|: every packet of it has the same mu, so there is no
+    variance to tame, and the rule's assumption (radiance constant near the horizon) fails."""
     amu = abs(uz)
-    return 1.0 / amu if amu >= mu_cut else 2.0 / mu_cut
+    return 1.0 / amu if (amu >= mu_cut or beam) else 2.0 / mu_cut
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score(sc, flux, radiance, level, w, ux, uy, uz):
-    """A crossing of tally level `level` (an in-water depth, or the air levels after them)."""
-    w_over_mu = w * inverse_mu(uz, sc.mu_cut)
+def score(sc, flux, radiance, level, w, ux, uy, uz, beam):
+    """A crossing of tally level `level` (an in-water depth, or the air levels after them);
+    beam: the packet is still part of the collimated solar beam."""
+    w_over_mu = w * inverse_mu(uz, sc.mu_cut, beam)
     if uz > 0.0:
         flux[level, FLUX_ED] += w
         flux[level, FLUX_EOD] += w_over_mu
@@ -59,9 +63,9 @@ def score(sc, flux, radiance, level, w, ux, uy, uz):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score_air_up(sc, flux, radiance, w, ux, uy, uz, water_leaving):
+def score_air_up(sc, flux, radiance, w, ux, uy, uz, water_leaving, beam):
     """Light travelling up at 0+: all of it at sc.air_level, and what came out of the water also
     at the water-leaving level after it."""
-    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz)
+    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
     if water_leaving:
-        score(sc, flux, radiance, sc.air_level + 1, w, ux, uy, uz)
+        score(sc, flux, radiance, sc.air_level + 1, w, ux, uy, uz, beam)

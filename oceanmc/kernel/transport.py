@@ -21,7 +21,7 @@ from . import local_estimate
 from .brdf import dispatch as brdf
 from .geometry import from_angles, turn
 from .interface import reflectance, refract
-from .models import (BOTTOM_BLACK, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
+from .models import (BOTTOM_BLACK, BOTTOM_SPECULAR, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
 from .phase import dispatch as phase
 from .sources import sky_cosine
@@ -47,25 +47,26 @@ def survives_roulette(sc, w):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
-    """Follows one packet that arrives at the surface from the air; returns its scattering count."""
-    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz)
+def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget):
+    """Follows one packet that arrives at the surface from the air; returns its scattering count.
+    beam: it belongs to the collimated solar beam (until it scatters or meets a diffuse bottom)."""
+    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
     n = sc.n_water
     if sc.surface_flat:
         r, cos_t = reflectance(sc, 1.0, n, uz)
         if sc.analog:
             if np.random.random() < r:
-                score_air_up(sc, flux, radiance, w, ux, uy, -uz, False)
+                score_air_up(sc, flux, radiance, w, ux, uy, -uz, False, beam)
                 budget[BUDGET_SURFACE_REFLECTION] += w
                 return 0
         else:
             if r > 0.0:
-                score_air_up(sc, flux, radiance, w * r, ux, uy, -uz, False)
+                score_air_up(sc, flux, radiance, w * r, ux, uy, -uz, False, beam)
                 budget[BUDGET_SURFACE_REFLECTION] += w * r
             w *= 1.0 - r
         ux, uy, uz = refract(ux, uy, uz, 1.0 / n, cos_t)
     if sc.surface_tally >= 0:
-        score(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz)
+        score(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz, beam)
 
     plane_z = sc.plane_z
     bottom_plane = plane_z.shape[0] - 1
@@ -108,6 +109,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
                 u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
                 cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
                 ux, uy, uz = turn(ux, uy, uz, cos_s, TWO_PI * np.random.random())
+                beam = False
                 tau = exponential()
                 alive, w = survives_roulette(sc, w)
                 if not alive:
@@ -137,32 +139,32 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
         z = plane_z[target]
         level = sc.plane_tally[target]
         if level >= 0:
-            score(sc, flux, radiance, level, w, ux, uy, uz)
+            score(sc, flux, radiance, level, w, ux, uy, uz, beam)
 
         if target == 0:
             # at the surface from below
             if not sc.surface_flat:
-                score_air_up(sc, flux, radiance, w, ux, uy, uz, True)
+                score_air_up(sc, flux, radiance, w, ux, uy, uz, True, beam)
                 budget[BUDGET_WATER_LEAVING] += w
                 return events
             r, cos_t = reflectance(sc, n, 1.0, -uz)
             if sc.analog:
                 if np.random.random() >= r:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, flux, radiance, w, ox, oy, oz, True)
+                    score_air_up(sc, flux, radiance, w, ox, oy, oz, True, beam)
                     budget[BUDGET_WATER_LEAVING] += w
                     return events
             else:
                 leaving = w * (1.0 - r)
                 if leaving > 0.0:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, flux, radiance, leaving, ox, oy, oz, True)
+                    score_air_up(sc, flux, radiance, leaving, ox, oy, oz, True, beam)
                     budget[BUDGET_WATER_LEAVING] += leaving
                 w *= r
             uz = -uz
             seg = 0
             if level >= 0 and w > 0.0:
-                score(sc, flux, radiance, level, w, ux, uy, uz)
+                score(sc, flux, radiance, level, w, ux, uy, uz, beam)
         elif target == bottom_plane:
             if sc.bottom_model == BOTTOM_BLACK:
                 budget[BUDGET_BOTTOM] += w
@@ -171,6 +173,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
                 local_estimate.score_bottom(sc, local, w, ux, uy, uz)
             ux, uy, uz, rho = brdf.reflect(sc.bottom_model, sc.bottom_params, ux, uy, uz,
                                            np.random.random(), np.random.random())
+            beam = beam and sc.bottom_model == BOTTOM_SPECULAR
             if sc.analog:
                 if np.random.random() >= rho:
                     budget[BUDGET_BOTTOM] += w
@@ -180,7 +183,7 @@ def trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget):
                 w *= rho
             seg = bottom_plane - 1
             if level >= 0 and w > 0.0:
-                score(sc, flux, radiance, level, w, ux, uy, uz)
+                score(sc, flux, radiance, level, w, ux, uy, uz, beam)
         else:
             seg = target if uz > 0.0 else target - 1
             continue
@@ -210,8 +213,10 @@ def trace_batch(sc, n_photons, seed, flux, radiance, local, budget):
         if i < n_sky:
             ux, uy, uz = from_angles(sky_cosine(sc.sky_model), TWO_PI * np.random.random())
             w = w_sky
+            beam = False
         else:
             ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
             w = w_sun
-        events += trace_photon(sc, w, ux, uy, uz, flux, radiance, local, budget)
+            beam = True
+        events += trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget)
     return events
