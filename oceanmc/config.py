@@ -213,6 +213,7 @@ class Tallies(_Strict):
                                                            allow_inf_nan=False)]]] \
         = Field(default_factory=list, max_length=64)
     grazing_mu_cut: Annotated[float, Field(gt=0.0, le=0.1, allow_inf_nan=False)] = 0.01
+    nadir_estimator: Literal["auto", "local", "crossing"] = "auto"
 
     @field_validator("depths_m")
     @classmethod
@@ -279,11 +280,21 @@ class SceneConfig(_Strict):
         if self.photons < 2 * self.batches:
             raise ValueError(f"photons = {self.photons}: need at least 2 per batch "
                              f"(batches = {self.batches})")
+        if self.tallies.nadir_estimator == "local" and self.bottom.model == "specular":
+            raise ValueError("tallies.nadir_estimator = 'local' with bottom.model = 'specular': "
+                             "a mirror has no density for a local estimate; use 'crossing' or "
+                             "'auto'")
         if self.tallies.local_directions_deg and self.bottom.model == "specular":
             raise ValueError("tallies.local_directions_deg with bottom.model = 'specular': a "
                              "mirror has no density for a local estimate; use the quad "
                              "radiances")
         return self
+
+    @property
+    def nadir_local(self) -> bool:
+        """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
+        mode = self.tallies.nadir_estimator
+        return mode == "local" or (mode == "auto" and self.bottom.model != "specular")
 
     @property
     def n_water(self) -> float:

@@ -163,10 +163,12 @@ def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
 
 def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_batch: int,
                  ed0: float, n_layers: int, radiance: bool, attrs: dict,
-                 directions: list = (), local_rows: list = ()) -> Result:
+                 directions: list = (), local_rows: list = (), nadir_local: bool = False
+                 ) -> Result:
     """Normalises raw per-batch weight sums (per launched photon, times Ed0; radiances also per
     quad solid angle) and derives the contract's quantities. directions: the (theta, phi) of the
-    local estimates, local_rows: their (water row, air row) in raw["local"]."""
+    local estimates, local_rows: their (water row, air row) in raw["local"]; nadir_local: Lu,
+    Lw_nadir and Rrs_nadir come from the local polar-cap estimate in raw["cap"]."""
     scale = ed0 / n_per_batch
     omega = grid.solid_angle
     q: dict[str, Quantity] = {}
@@ -220,6 +222,23 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             "remote-sensing reflectance Lw_nadir / Ed(0+)")
     lu_method = "polar-cap quad average (theta 175-180 deg with HydroLight edges), crossing " \
                 "estimator"
+    if nadir_local:
+        cap = raw["cap"] * scale
+        for name in ("Lu", "air/Lw_nadir", "air/Rrs_nadir"):
+            if name in q:  # the crossing estimate of the same cap average, for comparison
+                crossing = q.pop(name)
+                crossing.name = name + "_crossing"
+                crossing.description += " (crossing estimator)"
+                q[crossing.name] = crossing
+        add("Lu", ("depth",), cap[:, :n_depths], RAD_UNITS,
+            "nadir-viewing radiance (upward travel), the polar-cap quad average, local estimate")
+        add("air/Lw_nadir", (), cap[:, n_depths], RAD_UNITS,
+            "nadir water-leaving radiance at 0+, polar-cap quad average, local estimate")
+        add("air/Rrs_nadir", (), cap[:, n_depths] / ed0, "sr-1",
+            "remote-sensing reflectance Lw_nadir / Ed(0+)")
+        lu_method = "polar-cap quad average (theta 175-180 deg with HydroLight edges), local " \
+                    "(next-event) estimate; the crossing estimates of the same averages are " \
+                    "Lu_crossing, air/Lw_nadir_crossing, air/Rrs_nadir_crossing"
     if len(directions):
         local = raw["local"] * scale
         water_rows = [w for w, _ in local_rows]
@@ -232,21 +251,6 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             "local (next-event) estimate")
         add("air/Rrs_local", ("direction",), local[:, n_depths][:, air_rows] / ed0, "sr-1",
             "Lw_local / Ed(0+)")
-        nadir = [i for i, (theta, _) in enumerate(directions) if theta == 180.0]
-        if nadir and radiance:
-            i = nadir[0]
-            for name, values in (("Lu", local[:, :n_depths, water_rows[i]]),
-                                 ("air/Lw_nadir", local[:, n_depths, air_rows[i]]),
-                                 ("air/Rrs_nadir", local[:, n_depths, air_rows[i]] / ed0)):
-                q[name + "_quad"] = q.pop(name)
-                q[name + "_quad"].name = name + "_quad"
-                q[name + "_quad"].description += " (crossing estimator)"
-                add(name, q[name + "_quad"].dims, values, q[name + "_quad"].units,
-                    q[name + "_quad"].description.replace(
-                        "polar-cap quad average", "exact nadir, local estimate").replace(
-                        " (crossing estimator)", ""))
-            lu_method = "exact nadir, local (next-event) estimate; the polar-cap quad " \
-                        "averages are in Lu_quad, air/Lw_nadir_quad, air/Rrs_nadir_quad"
     budget = raw["budget"] / n_per_batch
     for column, name, description in budget_terms(n_layers):
         add(f"budget/{name}", (), budget[:, column], "1", description)

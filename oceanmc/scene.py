@@ -8,9 +8,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import config as cfg
-from . import phase_tables
+from . import cap_tables, phase_tables
 from .kernel import models
 from .kernel.interface import fresnel
+from .kernel.phase.dispatch import layer_density
 from .kernel.scene_arrays import SceneArrays
 
 PURE_WATER_BETA = 0.835   # 0.06225 (1 + 0.835 cos^2): Morel (1974)
@@ -163,6 +164,55 @@ def _mu_edges(theta_edges: np.ndarray) -> np.ndarray:
     return mu
 
 
+def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
+    """The nadir polar-cap local-estimate tables and constants (cap_tables.py)."""
+    beta = math.radians(180.0 - grid.theta_edges[-2])
+    n = config.n_water
+    beta_w = math.asin(math.sin(beta) / n)
+    mu_w = 0.5 * (1.0 + math.cos(beta))
+    mu_a = 0.5 * (1.0 + math.cos(beta_w))
+    fine_end, fine_step, coarse_step, fine_nodes = cap_tables.alpha_grid(beta)
+    alphas = cap_tables.alpha_nodes(beta)
+    tables: dict[tuple, int] = {}
+    table_of_layer = []
+    rows = {"m0w": [], "m1w": [], "m0a": [], "m1a": []}
+    enabled = config.nadir_local
+    for layer in range(len(config.water.layers)):
+        first, count = sc.layer_comp_start[layer], sc.layer_comp_count[layer]
+        key = tuple((int(sc.comp_model[k]), tuple(sc.comp_params[k]), int(sc.comp_tab_start[k]),
+                     float(sc.comp_cumweight[k])) for k in range(first, first + count))
+        if key not in tables and (enabled or not tables):
+            tables[key] = len(tables)
+            if enabled:
+                breaks = np.concatenate([sc.tab_psi[sc.comp_tab_start[k]:sc.comp_tab_start[k]
+                                                    + sc.comp_tab_len[k]]
+                                         for k in range(first, first + count)] + [np.zeros(0)])
+
+                def density(psi, layer=layer):
+                    return layer_density(sc, layer, psi)
+                for side, half, mean in (("w", beta, mu_w), ("a", beta_w, mu_a)):
+                    m0, m1 = cap_tables.cap_moments(density, breaks, half, mean, alphas)
+                    rows["m0" + side].append(m0)
+                    rows["m1" + side].append(m1)
+            else:
+                for name in rows:
+                    rows[name].append(np.zeros(len(alphas)))
+        table_of_layer.append(tables.get(key, 0))
+    step = 1e-6
+    h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
+                              config.surface.model == "flat")
+    return dict(
+        cap_estimates=enabled, cap_table_of_layer=np.array(table_of_layer, dtype=np.int64),
+        cap_m0w=np.array(rows["m0w"]), cap_m1w=np.array(rows["m1w"]),
+        cap_m0a=np.array(rows["m0a"]), cap_m1a=np.array(rows["m1a"]),
+        cap_fine_end=fine_end, cap_fine_step=fine_step, cap_coarse_step=coarse_step,
+        cap_fine_nodes=int(fine_nodes),
+        cap_mu_w=mu_w, cap_omega_w=2.0 * math.pi * (1.0 - math.cos(beta)),
+        cap_cos_water=math.cos(beta), cap_mu_a=mu_a,
+        cap_omega_a=2.0 * math.pi * (1.0 - math.cos(beta)), cap_cos_air=math.cos(beta),
+        cap_h=float(h[1]), cap_dh=float((h[2] - h[0]) / (2.0 * step)))
+
+
 def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
     """The kernel's view of a validated scene, and the tally grid. Raises TableError (a
     ConfigError) for unusable auxiliary files."""
@@ -240,5 +290,6 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         roulette_weight=float(config.estimator.roulette_weight),
         roulette_survival=float(config.estimator.roulette_survival),
         max_events=int(config.estimator.max_events),
+        **{name: 0 for name in SceneArrays._fields if name.startswith("cap_")},
     )
-    return sc, grid
+    return sc._replace(**_cap_fields(config, sc, grid)), grid

@@ -43,6 +43,7 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
         "flux": np.zeros((n_batches, n_depths + 2, 4)),
         "radiance": np.zeros((n_batches, n_depths + 2, nt, npf)),
         "local": np.zeros((n_batches, n_depths + 1, sc.le_dirs.shape[0])),
+        "cap": np.zeros((n_batches, n_depths + 1)),
         "budget": np.zeros((n_batches, len(budget_terms(n_layers)))),
         "events": np.zeros(n_batches, dtype=np.int64),
     }
@@ -50,7 +51,8 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
 
 def _run(sc, n_per_batch: int, seeds: np.ndarray, raw: dict, lo: int, hi: int) -> None:
     run_batches(sc, n_per_batch, seeds[lo:hi], raw["flux"][lo:hi], raw["radiance"][lo:hi],
-                raw["local"][lo:hi], raw["budget"][lo:hi], raw["events"][lo:hi])
+                raw["local"][lo:hi], raw["cap"][lo:hi], raw["budget"][lo:hi],
+                raw["events"][lo:hi])
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -108,7 +110,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         part = {name: values[:done] for name, values in raw.items()}
         return from_tallies(part, grid, np.array(depths), n_per_batch,
                             config.illumination.Ed0, n_layers, sc.tally_radiance, attrs,
-                            config.tallies.local_directions_deg, local_rows)
+                            config.tallies.local_directions_deg, local_rows, sc.cap_estimates)
 
     group = max(1, n_threads)
     done = 0

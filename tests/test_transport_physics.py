@@ -496,8 +496,13 @@ def test_chandrasekhar_semi_infinite():
     ref = radiance_band_reference(r, L, upward=True)
     cap = ref[-1, 0]
     zl = zr(r, r["air/Lu"], cap, r.stderr("air/Lu"), rel_max=0.04, what="nadir cap")
-    assert r["air/Lw_nadir"] == pytest.approx(r["air/Lu"], rel=1e-12)
+    assert r["air/Lw_nadir_crossing"] == pytest.approx(r["air/Lu"], rel=1e-12)
     assert r["air/Rrs_nadir"] == pytest.approx(r["air/Lw_nadir"], rel=1e-12)
+    # the local (next-event) estimate of the same cap average: same expectation, far smaller
+    # standard error
+    zr(r, r["air/Lw_nadir"], cap, r.stderr("air/Lw_nadir"), rel_max=0.003, what="local cap")
+    zr(r, r["Lu"][0], cap, r.stderr("Lu")[0], rel_max=0.003, what="local cap 0-")
+    assert r.stderr("air/Lw_nadir") < r.stderr("air/Lu") / 10.0
     zmax = compare_radiance(r, "air/radiance", None, ref, True, quad_rel_max=0.15,
                             band_rel_max=0.02, edge_rel_max=0.5, what="Chandrasekhar L(mu)")
     # absorbed + reflected = 1 (nothing is lost below a semi-infinite absorbing medium)

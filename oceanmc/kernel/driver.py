@@ -7,7 +7,7 @@ from .transport import trace_batch
 
 
 @njit(parallel=True, error_model="numpy", cache=True)
-def run_batches(sc, n_photons, seeds, flux, radiance, local, budget, events):
+def run_batches(sc, n_photons, seeds, flux, radiance, local, cap, budget, events):
     for i in prange(seeds.shape[0]):
         events[i] = trace_batch(sc, n_photons, seeds[i], flux[i], radiance[i], local[i],
-                                budget[i])
+                                cap[i], budget[i])

@@ -1,4 +1,5 @@
-"""Local (next-event, point) estimates of radiance in exact upward directions.
+"""Local (next-event, point) estimates: of radiance in exact upward directions, and of the
+nadir-viewing polar-cap average (Lu, Lw_nadir, Rrs_nadir; tables in cap_tables.py).
 
 At every collision a packet of weight w in a layer with scattering b and extinction c sends
 w (b/c) p(cos Theta) per steradian into the requested direction Omega; that light reaches a level
@@ -15,9 +16,12 @@ A mirror bottom has no density to evaluate, so scenes with one do not use these 
 """
 import math
 
+import numpy as np
 from numba import njit
 
 from .brdf import dispatch as brdf
+from .geometry import from_angles
+from .interface import fresnel
 from .phase import dispatch as phase
 
 
@@ -59,3 +63,65 @@ def score_bottom(sc, local, w, ux, uy, uz):
         dz = sc.le_dirs[k, 2]
         f = brdf.evaluate_local(sc.bottom_model, sc.bottom_params, -ux, uy, uz, dx, -dy, -dz)
         add_to_levels(sc, local, z, tau_here, k, w * f, -dz)
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def cap_lookup(sc, table, cos_alpha):
+    """(M0, M1) of the water cap and of the air cap's water side for a packet whose direction
+    makes the angle acos(cos_alpha) with straight up; linear in alpha on two uniform pieces."""
+    alpha = math.acos(min(1.0, max(-1.0, cos_alpha)))
+    if alpha < sc.cap_fine_end:
+        x = alpha / sc.cap_fine_step
+    else:
+        x = (sc.cap_fine_nodes - 1) + (alpha - sc.cap_fine_end) / sc.cap_coarse_step
+    i = min(int(x), sc.cap_m0w.shape[1] - 2)
+    f = x - i
+    g = 1.0 - f
+    return (g * sc.cap_m0w[table, i] + f * sc.cap_m0w[table, i + 1],
+            g * sc.cap_m1w[table, i] + f * sc.cap_m1w[table, i + 1],
+            g * sc.cap_m0a[table, i] + f * sc.cap_m0a[table, i + 1],
+            g * sc.cap_m1a[table, i] + f * sc.cap_m1a[table, i + 1])
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def cap_collision(sc, cap, seg, layer, z, w_scattered, uz):
+    """Polar-cap average of the nadir-viewing radiance sent by one collision to every level
+    above it and to 0+ (see cap_tables.py for the expansion and its accuracy)."""
+    m0w, m1w, m0a, m1a = cap_lookup(sc, sc.cap_table_of_layer[layer], -uz)
+    c = sc.layer_a[layer] + sc.layer_b[layer]
+    tau_here = sc.plane_tau[seg] + c * (z - sc.plane_z[seg])
+    mu = sc.cap_mu_w
+    for level in range(sc.level_z.shape[0]):
+        if sc.level_z[level] <= z:
+            dtau = tau_here - sc.level_tau[level]
+            g = math.exp(-dtau / mu) / mu
+            cap[level] += w_scattered * (m0w * g + m1w * g * (dtau / mu - 1.0) / mu) \
+                / sc.cap_omega_w
+    mu = sc.cap_mu_a
+    e = math.exp(-tau_here / mu)
+    cap[sc.level_z.shape[0]] += w_scattered * e * (
+        m0a * sc.cap_h + m1a * (sc.cap_h * tau_here / (mu * mu) + sc.cap_dh)) / sc.cap_omega_a
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def cap_bottom(sc, cap, w, ux, uy, uz):
+    """Polar-cap average of the radiance the bottom reflects from one packet: w f(wi, W) T for
+    one direction W drawn uniformly in the cap (an unbiased estimate of the cap average; f is
+    bounded for every non-mirror BRDF), once in water and once for the air cap."""
+    bottom_plane = sc.plane_z.shape[0] - 1
+    z = sc.plane_z[bottom_plane]
+    tau_b = sc.plane_tau[bottom_plane]
+    mu = 1.0 - np.random.random() * (1.0 - sc.cap_cos_water)
+    ox, oy, oz = from_angles(mu, 2.0 * math.pi * np.random.random())
+    f = brdf.evaluate_local(sc.bottom_model, sc.bottom_params, -ux, uy, uz, ox, -oy, oz)
+    for level in range(sc.level_z.shape[0]):
+        if sc.level_z[level] <= z:
+            cap[level] += w * f * math.exp(-(tau_b - sc.level_tau[level]) / mu)
+    mu_a = 1.0 - np.random.random() * (1.0 - sc.cap_cos_air)
+    sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / sc.n_water
+    mu_w = math.sqrt(1.0 - sin_w * sin_w)
+    t = 1.0 - fresnel(sc.n_water, 1.0, mu_w)[0] if sc.surface_flat else 1.0
+    phi = 2.0 * math.pi * np.random.random()
+    f = brdf.evaluate_local(sc.bottom_model, sc.bottom_params, -ux, uy, uz,
+                            sin_w * math.cos(phi), -sin_w * math.sin(phi), mu_w)
+    cap[sc.level_z.shape[0]] += w * f * math.exp(-tau_b / mu_w) * t / (sc.n_water * sc.n_water)

@@ -13,10 +13,25 @@ BOTTOM_BLACK = 1
 BOTTOM_LAMBERTIAN = 2
 BOTTOM_MINNAERT = 3
 BOTTOM_SPECULAR = 4
+BOTTOM_LAMBERTIAN_SPECULAR = 5   # rho_d/pi + rho_s mirror (a delta component)
+BOTTOM_GGX = 6           # GGX / Trowbridge-Reitz microfacets, Smith shadowing, Fresnel (+ rho_d/pi)
+BOTTOM_HAPKE = 7         # Hapke (1981/1993) with the shadow-hiding opposition (hot-spot) term
+BOTTOM_TABLE = 8         # measured BRDF on an angular grid (isotropic or anisotropic), from a file
+
+# The bottom parameter array (sc.bottom_params, float64): the model's scalar parameters in slots
+# 0 .. BRDF_NSCALARS - 1, then a header, then any tables (brdf_tables.py packs it). Offsets are
+# stored as floats (exact below 2^53) and read with int().
+BRDF_NSCALARS = 8
+BRDF_SAMPLER = 8         # 0: the model's own sampler; 1: the general tabulated sampler
+BRDF_SAMPLER_AT = 9      # offset of the general sampler's tables (brdf/general.py)
+BRDF_TABLE_AT = 10       # offset of a measured BRDF table (brdf/table.py)
+BRDF_HEADER = 16         # length of the fixed part
 
 # Sky radiance shapes.
 SKY_UNIFORM = 0
-SKY_CARDIOIDAL = 1       # L ~ 1 + 2 cos(zenith angle)
+SKY_CARDIOIDAL = 1       # L ~ 1 + 2 cos(zenith angle): the CIE standard overcast sky
+SKY_MAP = 2              # a tabulated radiance map, piecewise constant on its cells (sky_maps.py)
+SKY_HARRISON_COOMBES = 3  # Harrison & Coombes (1988) clear sky; a fine map as the proposal
 
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0

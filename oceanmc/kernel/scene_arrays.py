@@ -23,6 +23,12 @@ SceneArrays = namedtuple("SceneArrays", [
     "mu_cut", "level_z", "level_tau", "plane_tau",
     # local estimates: upward in-water directions (n, 3), t/n^2 for each at 0+
     "local_estimates", "le_dirs", "le_water", "le_air_factor",
+    # local estimates of the nadir polar-cap radiance (cap_tables.py): M0, M1 tables per
+    # distinct layer phase function on a two-piece uniform alpha grid
+    "cap_estimates", "cap_table_of_layer", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a",
+    "cap_fine_end", "cap_fine_step", "cap_coarse_step", "cap_fine_nodes",
+    "cap_mu_w", "cap_omega_w", "cap_cos_water", "cap_mu_a", "cap_omega_a", "cap_cos_air",
+    "cap_h", "cap_dh",
     # estimator
     "analog", "roulette_weight", "roulette_survival", "max_events",
 ])

@@ -47,7 +47,7 @@ def survives_roulette(sc, w):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget):
+def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
     """Follows one packet that arrives at the surface from the air; returns its scattering count.
     beam: it belongs to the collimated solar beam (until it scatters or meets a diffuse bottom)."""
     score(sc, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
@@ -98,6 +98,8 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget):
                 if sc.local_estimates:
                     local_estimate.score_collision(sc, local, seg, layer, z, w * (b / c),
                                                    ux, uy, uz)
+                if sc.cap_estimates:
+                    local_estimate.cap_collision(sc, cap, seg, layer, z, w * (b / c), uz)
                 if sc.analog:
                     if np.random.random() * c < a:
                         budget[BUDGET_LAYERS + layer] += w
@@ -171,6 +173,8 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget):
                 return events
             if sc.local_estimates:
                 local_estimate.score_bottom(sc, local, w, ux, uy, uz)
+            if sc.cap_estimates:
+                local_estimate.cap_bottom(sc, cap, w, ux, uy, uz)
             ux, uy, uz, rho = brdf.reflect(sc.bottom_model, sc.bottom_params, ux, uy, uz,
                                            np.random.random(), np.random.random())
             beam = beam and sc.bottom_model == BOTTOM_SPECULAR
@@ -193,7 +197,7 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget):
 
 
 @njit(error_model="numpy", cache=True)
-def trace_batch(sc, n_photons, seed, flux, radiance, local, budget):
+def trace_batch(sc, n_photons, seed, flux, radiance, local, cap, budget):
     """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
     packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
     come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
@@ -218,5 +222,5 @@ def trace_batch(sc, n_photons, seed, flux, radiance, local, budget):
             ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
             w = w_sun
             beam = True
-        events += trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, budget)
+        events += trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget)
     return events

@@ -1,41 +1,79 @@
 """Bottom reflection by model id, and the frame change between the kernel's global frame
-(z down) and the BRDF's local frame (normal along +z, pointing up into the water)."""
+(z down) and the BRDF's local frame (normal along +z, pointing up into the water).
+
+A model whose parameter array asks for it (params[BRDF_SAMPLER] = 1: Hapke, measured tables, or
+any model with `sampling: tabulated`) is sampled by the general tabulated sampler (general.py)
+and weighted f cos / pdf with its own evaluate(); the others use their own exact samplers. The
+length check on params keeps short parameter arrays (tests) on the models' own samplers."""
 from numba import njit
 
-from ..models import BOTTOM_LAMBERTIAN, BOTTOM_MINNAERT, BOTTOM_SPECULAR
-from . import lambertian, minnaert, specular
+from ..models import (BOTTOM_GGX, BOTTOM_HAPKE, BOTTOM_LAMBERTIAN, BOTTOM_LAMBERTIAN_SPECULAR,
+                      BOTTOM_MINNAERT, BOTTOM_SPECULAR, BOTTOM_TABLE, BRDF_SAMPLER)
+from . import general, ggx, hapke, lambertian, lambertian_specular, minnaert, specular, table
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def sample_local(model, params, wix, wiy, wiz, u1, u2):
-    if model == BOTTOM_LAMBERTIAN:
-        return lambertian.sample(params, wix, wiy, wiz, u1, u2)
-    if model == BOTTOM_MINNAERT:
-        return minnaert.sample(params, wix, wiy, wiz, u1, u2)
-    if model == BOTTOM_SPECULAR:
-        return specular.sample(params, wix, wiy, wiz, u1, u2)
-    return 0.0, 0.0, 1.0, 0.0  # black
+def tabulated_sampler(params):
+    return params.shape[0] > BRDF_SAMPLER and params[BRDF_SAMPLER] > 0.0
 
 
 @njit(error_model="numpy", cache=True, inline="always")
 def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
+    """f(wi, wo) in 1/sr; for models with a mirror component only the finite part (local
+    estimates miss the mirror: config.py refuses them for such bottoms)."""
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_MINNAERT:
         return minnaert.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_SPECULAR:
         return specular.evaluate(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_LAMBERTIAN_SPECULAR:
+        return lambertian_specular.evaluate(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_GGX:
+        return ggx.evaluate(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_HAPKE:
+        return hapke.evaluate(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_TABLE:
+        return table.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     return 0.0
 
 
 @njit(error_model="numpy", cache=True, inline="always")
+def sample_local(model, params, wix, wiy, wiz, u1, u2):
+    """(wox, woy, woz, weight) with weight = f cos(theta_o) / pdf."""
+    if tabulated_sampler(params):
+        wox, woy, woz, dens = general.sample(params, wix, wiy, wiz, u1, u2)
+        if dens <= 0.0:
+            return wox, woy, woz, 0.0
+        return wox, woy, woz, evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz) / dens
+    if model == BOTTOM_LAMBERTIAN:
+        return lambertian.sample(params, wix, wiy, wiz, u1, u2)
+    if model == BOTTOM_MINNAERT:
+        return minnaert.sample(params, wix, wiy, wiz, u1, u2)
+    if model == BOTTOM_SPECULAR:
+        return specular.sample(params, wix, wiy, wiz, u1, u2)
+    if model == BOTTOM_LAMBERTIAN_SPECULAR:
+        return lambertian_specular.sample(params, wix, wiy, wiz, u1, u2)
+    if model == BOTTOM_GGX:
+        return ggx.sample(params, wix, wiy, wiz, u1, u2)
+    return 0.0, 0.0, 1.0, 0.0  # black (Hapke and tables always use the tabulated sampler)
+
+
+@njit(error_model="numpy", cache=True, inline="always")
 def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
+    """Density (1/sr) of the sampler in use; for a mirror component only its finite part."""
+    if tabulated_sampler(params):
+        return general.pdf(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.pdf(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_MINNAERT:
         return minnaert.pdf(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_SPECULAR:
         return specular.pdf(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_LAMBERTIAN_SPECULAR:
+        return lambertian_specular.pdf(params, wix, wiy, wiz, wox, woy, woz)
+    if model == BOTTOM_GGX:
+        return ggx.pdf(params, wix, wiy, wiz, wox, woy, woz)
     return 0.0
 
 

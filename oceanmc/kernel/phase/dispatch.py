@@ -1,5 +1,8 @@
 """One entry point for the phase function of a layer: pick a component by its scattering weight,
 then sample or evaluate it by model id."""
+import math
+
+import numpy as np
 from numba import njit
 
 from ..models import PHASE_HG, PHASE_ISOTROPIC, PHASE_QUADRATIC, PHASE_TABULATED
@@ -71,3 +74,28 @@ def evaluate(sc, layer, cos_psi):
                                              sc.comp_tab_start[k], sc.comp_tab_len[k],
                                              sc.tab_psi, sc.tab_q, cos_psi)
     return total
+
+
+@njit(error_model="numpy", cache=True)
+def layer_density(sc, layer, angles):
+    """q(psi) = 2 pi p(psi) sin(psi) of the layer's phase function at each angle (rad), for
+    tables built once per scene; tabulated components are read exactly, without the loss of
+    precision of cos(psi) near 0."""
+    out = np.empty(angles.shape[0])
+    first = sc.layer_comp_start[layer]
+    for i in range(angles.shape[0]):
+        angle = angles[i]
+        total = 0.0
+        previous = 0.0
+        for k in range(first, first + sc.layer_comp_count[layer]):
+            weight = sc.comp_cumweight[k] - previous
+            previous = sc.comp_cumweight[k]
+            if sc.comp_model[k] == PHASE_TABULATED:
+                total += weight * tabulated.density(sc.tab_psi, sc.tab_q, sc.comp_tab_start[k],
+                                                    sc.comp_tab_len[k], angle)
+            else:
+                total += weight * 2.0 * math.pi * math.sin(angle) * evaluate_component(
+                    sc.comp_model[k], component_params(sc, k), 0, 0, sc.tab_psi, sc.tab_q,
+                    math.cos(angle))
+        out[i] = total
+    return out

@@ -29,10 +29,9 @@ def sample(psi, q, cdf, start, length, u):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def evaluate(psi, q, start, length, cos_psi):
-    """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
-    tends to a finite limit, taken by staying EDGE rad inside the range."""
-    angle = min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
+def density(psi, q, start, length, angle):
+    """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
+    between nodes)."""
     lo = start
     hi = start + length - 1
     while hi - lo > 1:
@@ -42,5 +41,12 @@ def evaluate(psi, q, start, length, cos_psi):
         else:
             hi = mid
     frac = (angle - psi[lo]) / (psi[lo + 1] - psi[lo])
-    dens = q[lo] + frac * (q[lo + 1] - q[lo])
-    return dens / (2.0 * math.pi * math.sin(angle))
+    return q[lo] + frac * (q[lo + 1] - q[lo])
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def evaluate(psi, q, start, length, cos_psi):
+    """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
+    tends to a finite limit, taken by staying EDGE rad inside the range."""
+    angle = min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
+    return density(psi, q, start, length, angle) / (2.0 * math.pi * math.sin(angle))

@@ -1,0 +1,107 @@
+"""Tables for the local estimate of the nadir-viewing polar-cap radiance (Lu, Lw_nadir, Rrs).
+
+The cap average of the radiance a collision sends up to a level is
+    (1/dOmega) integral over the cap of w p(u . W) g(mu_W) dW,   g(mu) = exp(-dtau/mu) / mu,
+where u is the packet's direction and W runs over the cap (half-angle beta about straight up).
+A local estimate in the exact nadir direction alone has infinite variance with forward-peaked
+phase functions (for Petzold 4 pi integral of p^2 dOmega = 4e6); the cap integral of p is bounded
+by 1/dOmega. g varies by less than (dtau + 1)(1 - cos beta) over the cap, so it is expanded to
+first order about the cap's mean cosine mu_bar:
+    integral p g dW = M0 g(mu_bar) + M1 g'(mu_bar) + O(g'' (1 - cos beta)^2),
+    M0(alpha) = integral_cap p dW,   M1(alpha) = integral_cap p (mu_W - mu_bar) dW,
+which depend only on the angle alpha between u and the cap axis. The neglected term is below
+(dtau^2/8)(1 - cos beta)^2 = 2e-6 dtau^2 relative for the 5 deg cap, and its weight exp(-dtau)
+keeps it below 1e-5 overall. M0 and M1 are integrals over the scattering angle psi of
+q(psi) = 2 pi p sin(psi) times the share of the circle of radius psi about u that lies in the
+cap, which spherical trigonometry gives in closed form (cos mu_W = cos alpha cos psi +
+sin alpha sin psi cos phi; inside when cos phi >= X).
+
+For 0+ the air cap (half-angle beta) is the water cap of half-angle asin(sin beta / n); the
+air-side average brings the Fresnel transmittance t and the solid-angle factor mu_w / mu_a
+(L_air = t L_water / n^2 and n^2 mu_w dOmega_w = mu_a dOmega_a), so g there is
+exp(-tau/mu) h(mu) with h = t(mu) / mu_a(mu).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# alpha grid: fine where the cap and the forward peak overlap, coarser beyond
+ALPHA_FINE_SPAN_CAPS = 4.0
+ALPHA_FINE_NODES = 801
+ALPHA_COARSE_NODES = 1800
+PSI_NODES = 600
+
+
+def alpha_grid(beta: float) -> tuple[float, float, float, int]:
+    """(fine end, fine step, coarse step, fine node count) of the two uniform pieces."""
+    fine_end = min(math.pi / 2, ALPHA_FINE_SPAN_CAPS * beta)
+    fine_step = fine_end / (ALPHA_FINE_NODES - 1)
+    coarse_step = (math.pi - fine_end) / (ALPHA_COARSE_NODES - 1)
+    return fine_end, fine_step, coarse_step, ALPHA_FINE_NODES
+
+
+def alpha_nodes(beta: float) -> np.ndarray:
+    fine_end, _, _, _ = alpha_grid(beta)
+    return np.concatenate([np.linspace(0.0, fine_end, ALPHA_FINE_NODES),
+                           np.linspace(fine_end, math.pi, ALPHA_COARSE_NODES)[1:]])
+
+
+def cap_moments(density, breaks: np.ndarray, beta: float, mu_bar: float, alphas: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(M0, M1) at each alpha for a cap of half-angle beta; density(psi) -> q(psi), the phase
+    function's probability density per unit scattering angle (integrates to 1 over 0..pi),
+    linear between the angles `breaks` where it is tabulated (kept as quadrature nodes, so the
+    table's own integral is exact)."""
+    cos_b = math.cos(beta)
+    m0 = np.empty(len(alphas))
+    m1 = np.empty(len(alphas))
+    for i, alpha in enumerate(alphas):
+        lo = abs(alpha - beta)
+        hi = min(math.pi, alpha + beta)
+        total0 = 0.0
+        total1 = 0.0
+        if alpha < beta:  # the circles with psi <= beta - alpha lie wholly inside the cap
+            psi = _nodes(0.0, beta - alpha, breaks)
+            q = density(psi)
+            mu = np.cos(alpha) * np.cos(psi)  # the circle's mean cos about the cap axis
+            total0 += np.trapezoid(q, psi)
+            total1 += np.trapezoid(q * mu, psi)
+        psi = _nodes(lo, hi, breaks)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            x = (cos_b - math.cos(alpha) * np.cos(psi)) / (math.sin(alpha) * np.sin(psi))
+        phi0 = np.arccos(np.clip(np.nan_to_num(x, nan=1.0, posinf=1.0, neginf=-1.0), -1.0, 1.0))
+        q = density(psi)
+        share = phi0 / math.pi
+        # mean of cos(angle to the axis) over the arc |phi| < phi0, times the share
+        arc_mu = (phi0 * math.cos(alpha) * np.cos(psi)
+                  + math.sin(alpha) * np.sin(psi) * np.sin(phi0)) / math.pi
+        total0 += np.trapezoid(q * share, psi)
+        total1 += np.trapezoid(q * arc_mu, psi)
+        m0[i] = total0
+        m1[i] = total1 - mu_bar * total0
+    return m0, m1
+
+
+def _nodes(lo: float, hi: float, breaks: np.ndarray) -> np.ndarray:
+    """Quadrature nodes on [lo, hi]: uniform, graded towards lo (where a forward peak sits when
+    lo ~ 0), and the density's own break points."""
+    if hi <= lo:
+        return np.array([lo, lo])
+    uniform = np.linspace(lo, hi, PSI_NODES)
+    start = max(lo, 1e-9)
+    graded = np.geomspace(start, hi, PSI_NODES) if hi > start else uniform
+    inside = breaks[(breaks > lo) & (breaks < hi)]
+    return np.unique(np.concatenate([uniform, graded, inside, [lo, hi]]))
+
+
+def air_factor(mu_w: np.ndarray, n: float, flat: bool) -> np.ndarray:
+    """h(mu_w) = t(mu_w) / mu_a(mu_w) for the water-side directions of the air cap."""
+    from .kernel.interface import fresnel
+    if not flat:
+        return 1.0 / mu_w
+    sin_a = np.sqrt(np.clip(1.0 - mu_w ** 2, 0.0, 1.0)) * n
+    mu_a = np.sqrt(np.clip(1.0 - sin_a ** 2, 0.0, 1.0))
+    t = np.array([1.0 - fresnel(n, 1.0, float(m))[0] for m in mu_w])
+    return t / mu_a
