@@ -31,7 +31,7 @@ import numpy as np
 ALPHA_FINE_SPAN_CAPS = 4.0
 ALPHA_FINE_NODES = 801
 ALPHA_COARSE_NODES = 1800
-PSI_NODES = 600
+PSI_NODES = 300
 
 
 def alpha_grid(beta: float) -> tuple[float, float, float, int]:
@@ -48,52 +48,50 @@ def alpha_nodes(beta: float) -> np.ndarray:
                            np.linspace(fine_end, math.pi, ALPHA_COARSE_NODES)[1:]])
 
 
-def cap_moments(density, breaks: np.ndarray, beta: float, mu_bar: float, alphas: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """(M0, M1) at each alpha for a cap of half-angle beta; density(psi) -> q(psi), the phase
-    function's probability density per unit scattering angle (integrates to 1 over 0..pi),
-    linear between the angles `breaks` where it is tabulated (kept as quadrature nodes, so the
-    table's own integral is exact)."""
-    cos_b = math.cos(beta)
-    m0 = np.empty(len(alphas))
-    m1 = np.empty(len(alphas))
-    for i, alpha in enumerate(alphas):
-        lo = abs(alpha - beta)
-        hi = min(math.pi, alpha + beta)
-        total0 = 0.0
-        total1 = 0.0
-        if alpha < beta:  # the circles with psi <= beta - alpha lie wholly inside the cap
-            psi = _nodes(0.0, beta - alpha, breaks)
-            q = density(psi)
-            mu = np.cos(alpha) * np.cos(psi)  # the circle's mean cos about the cap axis
-            total0 += np.trapezoid(q, psi)
-            total1 += np.trapezoid(q * mu, psi)
-        psi = _nodes(lo, hi, breaks)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            x = (cos_b - math.cos(alpha) * np.cos(psi)) / (math.sin(alpha) * np.sin(psi))
-        phi0 = np.arccos(np.clip(np.nan_to_num(x, nan=1.0, posinf=1.0, neginf=-1.0), -1.0, 1.0))
-        q = density(psi)
-        share = phi0 / math.pi
-        # mean of cos(angle to the axis) over the arc |phi| < phi0, times the share
-        arc_mu = (phi0 * math.cos(alpha) * np.cos(psi)
-                  + math.sin(alpha) * np.sin(psi) * np.sin(phi0)) / math.pi
-        total0 += np.trapezoid(q * share, psi)
-        total1 += np.trapezoid(q * arc_mu, psi)
-        m0[i] = total0
-        m1[i] = total1 - mu_bar * total0
-    return m0, m1
+def cumulative(density, breaks: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(psi, integral of q from 0 to psi, integral of q cos(psi)) on a fine grid that holds the
+    density's own break points, so a tabulated q (linear between them) is integrated exactly and
+    a forward spike in its first interval keeps its mass."""
+    psi = np.unique(np.concatenate([breaks[(breaks >= 0.0) & (breaks <= math.pi)],
+                                    np.linspace(0.0, math.pi, 4001),
+                                    np.geomspace(1e-9, math.pi, 4001)]))
+    q = density(psi)
+    step = np.diff(psi)
+    mass = 0.5 * (q[1:] + q[:-1]) * step
+    qc = q * np.cos(psi)
+    mass_cos = 0.5 * (qc[1:] + qc[:-1]) * step
+    return (psi, np.concatenate([[0.0], np.cumsum(mass)]),
+            np.concatenate([[0.0], np.cumsum(mass_cos)]))
 
 
-def _nodes(lo: float, hi: float, breaks: np.ndarray) -> np.ndarray:
-    """Quadrature nodes on [lo, hi]: uniform, graded towards lo (where a forward peak sits when
-    lo ~ 0), and the density's own break points."""
-    if hi <= lo:
-        return np.array([lo, lo])
-    uniform = np.linspace(lo, hi, PSI_NODES)
-    start = max(lo, 1e-9)
-    graded = np.geomspace(start, hi, PSI_NODES) if hi > start else uniform
-    inside = breaks[(breaks > lo) & (breaks < hi)]
-    return np.unique(np.concatenate([uniform, graded, inside, [lo, hi]]))
+def cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], beta: float, mu_bar: float,
+                alphas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(M0, M1) at each alpha for a cap of half-angle beta, from the cumulative integrals of q
+    (see cumulative). Circles of radius psi <= beta - alpha lie wholly in the cap; for the
+    others the probability between neighbouring quadrature angles (exact, from the cumulative
+    integral) is weighted by the share of the circle in the cap at their midpoint."""
+    psi_grid, cdf, cdf_cos = table
+    alpha = alphas[:, None]
+    inside = np.clip(beta - alphas, 0.0, None)
+    m0 = np.interp(inside, psi_grid, cdf)
+    m1 = np.cos(alphas) * np.interp(inside, psi_grid, cdf_cos)
+    lo = np.abs(alphas - beta)[:, None]
+    hi = np.minimum(math.pi, alphas + beta)[:, None]
+    s = np.unique(np.concatenate([np.linspace(0.0, 1.0, PSI_NODES),
+                                  np.geomspace(1e-7, 1.0, PSI_NODES),
+                                  1.0 - np.geomspace(1e-7, 1.0, PSI_NODES)]))
+    psi = lo + (hi - lo) * s[None, :]
+    mass = np.diff(np.interp(psi, psi_grid, cdf), axis=1)
+    mid = 0.5 * (psi[:, 1:] + psi[:, :-1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = (math.cos(beta) - np.cos(alpha) * np.cos(mid)) / (np.sin(alpha) * np.sin(mid))
+    phi0 = np.arccos(np.clip(np.nan_to_num(x, nan=1.0, posinf=1.0, neginf=-1.0), -1.0, 1.0))
+    # mean of cos(angle to the axis) over the arc |phi| < phi0, times the arc's share
+    arc_mu = (phi0 * np.cos(alpha) * np.cos(mid)
+              + np.sin(alpha) * np.sin(mid) * np.sin(phi0)) / math.pi
+    m0 = m0 + np.sum(mass * phi0 / math.pi, axis=1)
+    m1 = m1 + np.sum(mass * arc_mu, axis=1)
+    return m0, m1 - mu_bar * m0
 
 
 def air_factor(mu_w: np.ndarray, n: float, flat: bool) -> np.ndarray:

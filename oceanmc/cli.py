@@ -203,6 +203,28 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return validation.main(Path(args.output), quick=args.quick)
 
 
+def cmd_bench(args: argparse.Namespace) -> int:
+    from . import bench
+
+    configs = Path(args.configs)
+    if not (configs / "bare_walk.yaml").is_file():
+        raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
+                         "repository root, or point --configs at its configs/ folder)")
+    bare_walk = Path(args.bare_walk) if args.bare_walk else None
+    if bare_walk is None:
+        for candidate in (Path("../shared/bench/bare_walk.py"),
+                          Path(__file__).resolve().parents[2] / "shared/bench/bare_walk.py"):
+            if candidate.is_file():
+                bare_walk = candidate
+                break
+    elif not bare_walk.is_file():
+        raise UsageError(f"--bare-walk {bare_walk}: no such file")
+    if bare_walk is None:
+        print("oceanmc: bench: shared/bench/bare_walk.py not found; the speed ceiling is "
+              "reported without it (--bare-walk PATH)", file=sys.stderr)
+    return bench.main(Path(args.output), configs, bare_walk, quick=args.quick)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="oceanmc",
@@ -239,6 +261,16 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--quick", action="store_true",
                           help="fewer photons: a fast check, looser standard errors")
     validate.set_defaults(func=cmd_validate)
+
+    bench = sub.add_parser("bench", help="run time against error; speed against the bare walk")
+    bench.add_argument("-o", "--output", default="benchmarks", metavar="DIR",
+                       help="report folder (default: benchmarks)")
+    bench.add_argument("--quick", action="store_true", help="small counts: a smoke test")
+    bench.add_argument("--configs", default="configs", metavar="DIR",
+                       help="folder with the benchmark scenes (default: configs)")
+    bench.add_argument("--bare-walk", metavar="PATH",
+                       help="the speed-ceiling script (default: ../shared/bench/bare_walk.py)")
+    bench.set_defaults(func=cmd_bench)
 
     show = sub.add_parser("show", help="print the summary of a results file")
     show.add_argument("file", metavar="RESULT.h5")

@@ -150,11 +150,23 @@ class Water(_Strict):
 
 # --- illumination, surface, bottom -----------------------------------------------------------
 
+class SkyMap(_Strict):
+    """A sky radiance map from a file (sky_maps.py): an equirectangular (theta_view, phi_view)
+    array in .npy, .npz or HDF5; its absolute scale is irrelevant (the sky's share of Ed0 is
+    diffuse_fraction)."""
+    map: str
+    dataset: str = "radiance"
+
+
 class Illumination(_Strict):
+    """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
+    Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
+    sun_zenith_deg); or {map: FILE} (sky_maps.py)."""
     Ed0: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
-    sky: Literal["uniform", "cardioidal"] = "uniform"
+    sky: Union[Literal["uniform", "cardioidal", "overcast", "harrison_coombes"], SkyMap] \
+        = "uniform"
 
 
 class Surface(_Strict):
@@ -173,9 +185,19 @@ class BlackBottom(_Strict):
     model: Literal["black"]
 
 
+# Every BRDF below is checked when the scene is built (brdf_tables.py): f >= 0, reciprocity
+# f(i, o) = f(o, i) and energy conservation rho_dh(theta_i) <= 1; a violation is a ConfigError
+# naming the model and the worst incidence angle unless allow_unphysical is true.
+# sampling: auto = the model's own sampler; tabulated = the general tabulated sampler (exact in
+# expectation; for comparisons and for models without an analytic sampler).
+Sampling = Literal["auto", "tabulated"]
+
+
 class LambertianBottom(_Strict):
     model: Literal["lambertian"]
     reflectance: Fraction
+    sampling: Sampling = "auto"
+    allow_unphysical: bool = False
 
 
 class MinnaertBottom(_Strict):
@@ -183,6 +205,8 @@ class MinnaertBottom(_Strict):
     model: Literal["minnaert"]
     reflectance: Fraction
     k: Annotated[float, Field(ge=0.0, le=100.0, allow_inf_nan=False)]
+    sampling: Sampling = "auto"
+    allow_unphysical: bool = False
 
 
 class SpecularBottom(_Strict):
@@ -190,10 +214,71 @@ class SpecularBottom(_Strict):
     reflectance: Fraction
 
 
+class LambertianSpecularBottom(_Strict):
+    """diffuse_reflectance/pi + specular_reflectance x mirror; rho_dh is their sum."""
+    model: Literal["lambertian_specular"]
+    diffuse_reflectance: Fraction
+    specular_reflectance: Fraction
+    allow_unphysical: bool = False
+
+
+class GGXBottom(_Strict):
+    """Glossy microfacets: GGX (Trowbridge-Reitz) with roughness alpha, height-correlated Smith
+    shadowing, Fresnel reflection at facets of relative index n_ratio (fresnel: false makes them
+    perfect mirrors, F = 1), plus an optional Lambertian term (kernel/brdf/ggx.py)."""
+    model: Literal["ggx"]
+    roughness: Annotated[float, Field(ge=0.01, le=1.0, allow_inf_nan=False)]
+    n_ratio: Annotated[float, Field(gt=1.0, le=10.0, allow_inf_nan=False)] = 1.15
+    fresnel: bool = True
+    diffuse_reflectance: Fraction = 0.0
+    sampling: Sampling = "auto"
+    allow_unphysical: bool = False
+
+
+class HapkeBottom(_Strict):
+    """Hapke's model with the shadow-hiding opposition (hot-spot) term, for sediments
+    (kernel/brdf/hapke.py): grain single-scattering albedo, Henyey-Greenstein asymmetry of the
+    grains (negative: backward), opposition surge amplitude B0 and width h."""
+    model: Literal["hapke"]
+    albedo: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)]
+    asymmetry: Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)] = 0.0
+    opposition_amplitude: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 0.5
+    opposition_width: Annotated[float, Field(gt=0.0, le=2.0, allow_inf_nan=False)] = 0.06
+    allow_unphysical: bool = False
+
+
+class TableBottom(_Strict):
+    """A measured BRDF on an angular grid from a file (brdf_tables.read_brdf_table): isotropic
+    (theta_i, theta_r, dphi) or anisotropic (theta_i, phi_i, theta_r, dphi); values in 1/sr, or
+    reflectance factors (pi f) with quantity: reflectance_factor."""
+    model: Literal["table"]
+    file: str
+    quantity: Literal["brdf", "reflectance_factor"] = "brdf"
+    reciprocity_tolerance: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.05
+    allow_unphysical: bool = False
+
+
 Bottom = Annotated[
-    Union[NoBottom, BlackBottom, LambertianBottom, MinnaertBottom, SpecularBottom],
+    Union[NoBottom, BlackBottom, LambertianBottom, MinnaertBottom, SpecularBottom,
+          LambertianSpecularBottom, GGXBottom, HapkeBottom, TableBottom],
     Field(discriminator="model"),
 ]
+
+
+def bottom_has_mirror(bottom) -> bool:
+    """Whether the bottom reflects part of the light as a mirror: a delta function, which a
+    local (next-event) estimate cannot evaluate."""
+    if bottom.model == "specular":
+        return True
+    return bottom.model == "lambertian_specular" and bottom.specular_reflectance > 0.0
+
+
+def bottom_weight_bounded(bottom) -> bool:
+    """Whether the bottom's sampling weight f cos / pdf never exceeds 1 (analog bottom
+    reflection survives with probability = weight, so it needs this)."""
+    if bottom.model in ("hapke", "table") or getattr(bottom, "sampling", "auto") == "tabulated":
+        return False
+    return not (bottom.model == "ggx" and bottom.diffuse_reflectance > 0.0)
 
 
 # --- tallies and estimator -------------------------------------------------------------------
@@ -280,21 +365,26 @@ class SceneConfig(_Strict):
         if self.photons < 2 * self.batches:
             raise ValueError(f"photons = {self.photons}: need at least 2 per batch "
                              f"(batches = {self.batches})")
-        if self.tallies.nadir_estimator == "local" and self.bottom.model == "specular":
-            raise ValueError("tallies.nadir_estimator = 'local' with bottom.model = 'specular': "
-                             "a mirror has no density for a local estimate; use 'crossing' or "
-                             "'auto'")
-        if self.tallies.local_directions_deg and self.bottom.model == "specular":
-            raise ValueError("tallies.local_directions_deg with bottom.model = 'specular': a "
-                             "mirror has no density for a local estimate; use the quad "
-                             "radiances")
+        if self.tallies.nadir_estimator == "local" and bottom_has_mirror(self.bottom):
+            raise ValueError(f"tallies.nadir_estimator = 'local' with bottom.model = "
+                             f"{self.bottom.model!r}: a mirror has no density for a local "
+                             "estimate; use 'crossing' or 'auto'")
+        if self.tallies.local_directions_deg and bottom_has_mirror(self.bottom):
+            raise ValueError(f"tallies.local_directions_deg with bottom.model = "
+                             f"{self.bottom.model!r}: a mirror has no density for a local "
+                             "estimate; use the quad radiances")
+        if self.estimator.mode == "analog" and not bottom_weight_bounded(self.bottom):
+            raise ValueError(f"estimator.mode = 'analog' with bottom.model = "
+                             f"{self.bottom.model!r} sampled by weight f cos/pdf, which can "
+                             "exceed 1: analog bottom reflection (survival with probability = "
+                             "weight) cannot carry it; use estimator.mode = 'implicit'")
         return self
 
     @property
     def nadir_local(self) -> bool:
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
         mode = self.tallies.nadir_estimator
-        return mode == "local" or (mode == "auto" and self.bottom.model != "specular")
+        return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom))
 
     @property
     def n_water(self) -> float:
@@ -310,8 +400,8 @@ def _key_path(loc: tuple) -> str:
             path += f"[{part}]"
         elif part in {"isotropic", "rayleigh", "pure_water", "henyey_greenstein", "two_term_hg",
                       "fournier_forand", "petzold", "table", "mixture", "none", "black",
-                      "lambertian", "minnaert", "specular"} or str(part).startswith(("list[",
-                                                                                      "literal[")):
+                      "lambertian", "minnaert", "specular", "lambertian_specular", "ggx",
+                      "hapke", "SkyMap"} or str(part).startswith(("list[", "literal[")):
             continue  # pydantic's union-branch tags are not keys the user wrote
         else:
             path += ("." if path else "") + str(part)
@@ -404,6 +494,10 @@ def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
         for phase in phases:
             if isinstance(phase, TablePhase):
                 phase.file = str((base_dir / phase.file).resolve())
+    if isinstance(config.bottom, TableBottom):
+        config.bottom.file = str((base_dir / config.bottom.file).resolve())
+    if isinstance(config.illumination.sky, SkyMap):
+        config.illumination.sky.map = str((base_dir / config.illumination.sky.map).resolve())
 
 
 def config_to_yaml(config: SceneConfig) -> str:

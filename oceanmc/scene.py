@@ -2,13 +2,14 @@
 integer model ids. No Python object crosses into the kernel."""
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import config as cfg
-from . import cap_tables, phase_tables
+from . import brdf_tables, cap_tables, phase_tables, sky_maps
 from .kernel import models
 from .kernel.interface import fresnel
 from .kernel.phase.dispatch import layer_density
@@ -149,19 +150,41 @@ def local_directions(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, n
 
 
 def _bottom(bottom) -> tuple[int, np.ndarray]:
-    ids = {"none": models.BOTTOM_NONE, "black": models.BOTTOM_BLACK,
-           "lambertian": models.BOTTOM_LAMBERTIAN, "minnaert": models.BOTTOM_MINNAERT,
-           "specular": models.BOTTOM_SPECULAR}
-    params = {"lambertian": [getattr(bottom, "reflectance", 0.0)],
-              "minnaert": [getattr(bottom, "reflectance", 0.0), getattr(bottom, "k", 0.0)],
-              "specular": [getattr(bottom, "reflectance", 0.0)]}.get(bottom.model, [])
-    return ids[bottom.model], np.array(params + [0.0] * (4 - len(params)), dtype=np.float64)
+    """(model id, packed parameter array): scalars, measured tables, the general sampler's
+    tables; the BRDF's physical checks run here (brdf_tables.py)."""
+    return brdf_tables.bottom_arrays(bottom)
 
 
 def _mu_edges(theta_edges: np.ndarray) -> np.ndarray:
     mu = np.cos(np.radians(theta_edges))
     mu[theta_edges == 90.0] = 0.0  # exact, so no downward photon lands in an upward band
     return mu
+
+
+_CAP_CACHE: dict[bytes, list[np.ndarray]] = {}
+
+
+def _layer_cap_moments(sc: SceneArrays, layer: int, breaks: np.ndarray, geometry: tuple,
+                       alphas: np.ndarray) -> list[np.ndarray]:
+    """[M0, M1] of the water cap and of the air cap's water side for one layer's phase function,
+    remembered within the process by the phase function's content (scenes of a batch, tests)."""
+    first, count = sc.layer_comp_start[layer], sc.layer_comp_count[layer]
+    digest = hashlib.sha1(np.array(geometry).tobytes())
+    for k in range(first, first + count):
+        digest.update(np.array([sc.comp_model[k], sc.comp_cumweight[k]]).tobytes())
+        digest.update(sc.comp_params[k].tobytes())
+        start, length = sc.comp_tab_start[k], sc.comp_tab_len[k]
+        digest.update(sc.tab_q[start:start + length].tobytes())
+        digest.update(sc.tab_psi[start:start + length].tobytes())
+    key = digest.digest()
+    if key not in _CAP_CACHE:
+        beta, mu_w, beta_w, mu_a = geometry
+        table = cap_tables.cumulative(lambda psi: layer_density(sc, layer, psi), breaks)
+        _CAP_CACHE[key] = [*cap_tables.cap_moments(table, beta, mu_w, alphas),
+                           *cap_tables.cap_moments(table, beta_w, mu_a, alphas)]
+        if len(_CAP_CACHE) > 64:
+            _CAP_CACHE.pop(next(iter(_CAP_CACHE)))
+    return _CAP_CACHE[key]
 
 
 def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
@@ -187,16 +210,12 @@ def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
                 breaks = np.concatenate([sc.tab_psi[sc.comp_tab_start[k]:sc.comp_tab_start[k]
                                                     + sc.comp_tab_len[k]]
                                          for k in range(first, first + count)] + [np.zeros(0)])
-
-                def density(psi, layer=layer):
-                    return layer_density(sc, layer, psi)
-                for side, half, mean in (("w", beta, mu_w), ("a", beta_w, mu_a)):
-                    m0, m1 = cap_tables.cap_moments(density, breaks, half, mean, alphas)
-                    rows["m0" + side].append(m0)
-                    rows["m1" + side].append(m1)
+                moments = _layer_cap_moments(sc, layer, breaks, (beta, mu_w, beta_w, mu_a),
+                                             alphas)
             else:
-                for name in rows:
-                    rows[name].append(np.zeros(len(alphas)))
+                moments = [np.zeros(len(alphas))] * 4
+            for name, values in zip(("m0w", "m1w", "m0a", "m1a"), moments):
+                rows[name].append(values)
         table_of_layer.append(tables.get(key, 0))
     step = 1e-6
     h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
@@ -263,7 +282,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
     sc = SceneArrays(
         sun_mu=math.cos(theta_s), sun_sin=math.sin(theta_s),
         diffuse_fraction=float(ill.diffuse_fraction),
-        sky_model=models.SKY_CARDIOIDAL if ill.sky == "cardioidal" else models.SKY_UNIFORM,
+        **sky_maps.sky_fields(ill),
         surface_flat=config.surface.model == "flat", n_water=float(config.n_water),
         fresnel_schlick=config.surface.fresnel == "schlick",
         plane_z=plane_z, plane_tally=plane_tally, segment_layer=segment_layer,

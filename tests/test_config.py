@@ -83,7 +83,7 @@ def _error(scene) -> str:
     (lambda s: s["illumination"].update(diffuse_fraction=1.2),
      "illumination.diffuse_fraction = 1.2", "less than or equal to 1"),
     (lambda s: s["illumination"].update(sky="stormy"), "illumination.sky = 'stormy'",
-     "'uniform' or 'cardioidal'"),
+     "'cardioidal'"),
     (lambda s: s.update(photons=0), "photons = 0", "greater than 0"),
     (lambda s: s.update(photons="many"), "photons = 'many'", "integer"),
     (lambda s: s["tallies"].update(depths_m=[0, 5]), "tallies.depths_m", "below the bottom"),

@@ -4,7 +4,7 @@ import math
 from numba import njit
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def turn(ux, uy, uz, cos_t, phi):
     """The direction at polar angle acos(cos_t) and azimuth phi about (ux, uy, uz), renormalised
     (the MCML rotation; Wang, Jacques & Zheng 1995, Comput. Meth. Prog. Bio. 47, 131)."""
@@ -27,7 +27,7 @@ def turn(ux, uy, uz, cos_t, phi):
     return nx * norm, ny * norm, nz * norm
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def from_angles(cos_t, phi):
     """Unit vector with polar cosine cos_t about +z and azimuth phi from +x."""
     sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))

@@ -4,7 +4,7 @@ import math
 from numba import njit
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def fresnel(n1, n2, cos_i):
     """(R, cos_t) for light going from index n1 into n2 at incidence cosine cos_i >= 0.
     R = (Rs + Rp)/2 (Born & Wolf, Principles of Optics, 1.5.3); total internal reflection gives
@@ -24,7 +24,7 @@ def fresnel(n1, n2, cos_i):
     return 0.5 * (rs * rs + rp * rp), cos_t
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def schlick(n1, n2, cos_i):
     """Schlick's approximation R0 + (1 - R0)(1 - cos)^5 (Schlick 1994), with the cosine taken on
     the less dense side and total internal reflection kept: offered for comparisons only."""
@@ -44,7 +44,7 @@ def reflectance(sc, n1, n2, cos_i):
     return fresnel(n1, n2, cos_i)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def refract(ux, uy, uz, ratio, cos_t):
     """Direction after crossing a horizontal interface: tangential components scale by
     ratio = n1/n2 (Snell), the vertical one keeps its sign with magnitude cos_t."""

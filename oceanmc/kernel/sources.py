@@ -1,14 +1,16 @@
 """Where photons come from: the sun's collimated beam and the sky's diffuse radiance, sampled in
-proportion to their contribution to the downward plane irradiance just above the surface."""
+proportion to their contribution to the downward plane irradiance just above the surface
+(sky_maps.py documents the sky shapes and the map conventions)."""
 import math
 
 import numpy as np
 from numba import njit
 
-from .models import SKY_CARDIOIDAL
+from .geometry import from_angles
+from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sky_cosine(sky_model):
     """Cosine of the travel direction's angle from nadir for a sky photon: density proportional to
     L(theta) cos(theta). Uniform L: cos = sqrt(u). Cardioidal L ~ 1 + 2 cos: the cosine-weighted
@@ -19,3 +21,85 @@ def sky_cosine(sky_model):
             if 3.0 * np.random.random() < 1.0 + 2.0 * mu:
                 return mu
     return math.sqrt(np.random.random())
+
+
+@njit(error_model="numpy", cache=True)
+def first_above_row(cdf, u):
+    """Smallest k with u < cdf[k] (cdf ends at 1)."""
+    lo = -1
+    hi = cdf.shape[0] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if u < cdf[mid]:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(error_model="numpy", cache=True)
+def first_above_cell(cdf, row, u):
+    """Smallest k with u < cdf[row, k] (indexed, not sliced: no view in the photon loop)."""
+    lo = -1
+    hi = cdf.shape[1] - 1
+    while hi - lo > 1:
+        mid = (lo + hi) >> 1
+        if u < cdf[row, mid]:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(error_model="numpy", cache=True)
+def harrison_coombes(p, ux, uy, uz):
+    """Harrison & Coombes (1988) radiance of the sky element a photon travelling (ux, uy, uz)
+    comes from (p: sun travel direction, cos of the sun zenith); sky_maps.py has the formula."""
+    cos_psi = min(1.0, max(-1.0, ux * p[0] + uy * p[1] + uz * p[2]))
+    psi = math.acos(cos_psi)
+    horizon = 1.0 - math.exp(-0.19 / uz) if uz > 0.0 else 1.0
+    return ((1.63 + 53.7 * math.exp(-5.49 * psi) + 2.04 * cos_psi * cos_psi * p[3]) * horizon
+            * (1.0 - math.exp(-0.53 / p[3])))
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def sky_direction(sc):
+    """(ux, uy, uz, weight factor) of a sky photon's travel direction. Tabulated skies: a row by
+    the marginal CDF, a cell by the row's conditional CDF, sin^2(theta) and phi uniform within
+    the cell (density exactly proportional to the cell's L cos); the map gives the view
+    direction, the photon travels the opposite way (phi + 180 deg). Harrison-Coombes is weighted
+    by L(direction) / L(cell), so its exact radiance is reproduced; maps and the analytic shapes
+    have factor 1."""
+    model = sc.sky_model
+    if model == SKY_MAP or model == SKY_HARRISON_COOMBES:
+        row = first_above_row(sc.sky_row_cdf, np.random.random())
+        col = first_above_cell(sc.sky_cell_cdf, row, np.random.random())
+        s0 = sc.sky_s_edges[row]
+        s = s0 + np.random.random() * (sc.sky_s_edges[row + 1] - s0)
+        p0 = sc.sky_phi_edges[col]
+        phi_view = p0 + np.random.random() * (sc.sky_phi_edges[col + 1] - p0)
+        sin_t = math.sqrt(min(1.0, max(0.0, s)))
+        uz = math.sqrt(max(0.0, 1.0 - s))
+        ux = -sin_t * math.cos(phi_view)
+        uy = -sin_t * math.sin(phi_view)
+        if model == SKY_HARRISON_COOMBES:
+            return ux, uy, uz, harrison_coombes(sc.sky_params, ux, uy, uz) \
+                / sc.sky_cell_L[row, col]
+        return ux, uy, uz, 1.0
+    mu = sky_cosine(model)
+    ux, uy, uz = from_angles(mu, 2.0 * math.pi * np.random.random())
+    return ux, uy, uz, 1.0
+
+
+@njit(error_model="numpy", cache=True)
+def sky_many(sc, n, seed):
+    """Rows (ux, uy, uz, weight factor) of n sky photons from seed (tests and reports)."""
+    np.random.seed(seed)
+    out = np.empty((n, 4))
+    for k in range(n):
+        ux, uy, uz, m = sky_direction(sc)
+        out[k, 0] = ux
+        out[k, 1] = uy
+        out[k, 2] = uz
+        out[k, 3] = m
+    return out

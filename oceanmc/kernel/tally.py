@@ -14,7 +14,7 @@ from numba import njit
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def theta_band(uz, mu_edges):
     """Index i with mu_edges[i] >= uz > mu_edges[i + 1] (mu_edges falls from 1 to -1)."""
     lo = 0
@@ -28,7 +28,7 @@ def theta_band(uz, mu_edges):
     return lo
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def phi_band(ux, uy, n_phi):
     """Band index with band 0 centred on phi = 0 (the sun's travel azimuth)."""
     phi = math.atan2(uy, ux)
@@ -36,7 +36,7 @@ def phi_band(ux, uy, n_phi):
     return k % n_phi
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def inverse_mu(uz, mu_cut, beam):
     """1/|mu|, or 2/mu_cut below the cut for diffuse light. A collimated beam (the unscattered
     sun) always gets the exact 1/|mu|: every packet of it has the same mu, so there is no

@@ -32,7 +32,7 @@ from ..geometry import from_angles
 from ..interface import fresnel as fresnel_r
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def lam(alpha, vz):
     """Smith's Lambda for GGX at direction cosine vz > 0."""
     c2 = vz * vz
@@ -42,21 +42,21 @@ def lam(alpha, vz):
     return 0.5 * (math.sqrt(1.0 + alpha * alpha * t2) - 1.0)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def distribution(alpha, hz):
     a2 = alpha * alpha
     d = hz * hz * (a2 - 1.0) + 1.0
     return a2 / (math.pi * d * d)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def facet_reflectance(params, cos_h):
     if params[3] == 0.0:
         return 1.0
     return fresnel_r(1.0, params[1], min(1.0, max(0.0, cos_h)))[0]
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def specular(params, wix, wiy, wiz, wox, woy, woz):
     """The microfacet part of f (1/sr)."""
     if wiz <= 0.0 or woz <= 0.0:
@@ -76,14 +76,14 @@ def specular(params, wix, wiy, wiz, wox, woy, woz):
     return facet_reflectance(params, cos_h) * distribution(alpha, hz) * g2 / (4.0 * wiz * woz)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
     return specular(params, wix, wiy, wiz, wox, woy, woz) + params[2] / math.pi
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def specular_share(params, wiz):
     if params[2] <= 0.0:
         return 1.0
@@ -91,7 +91,7 @@ def specular_share(params, wiz):
     return max(0.2, fs / (fs + params[2]))
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def specular_pdf(params, wix, wiy, wiz, wox, woy, woz):
     """Density of the reflected visible-normal sample: G1(wi) D(h) / (4 cos t_i)."""
     if wiz <= 0.0 or woz <= 0.0:
@@ -107,7 +107,7 @@ def specular_pdf(params, wix, wiy, wiz, wox, woy, woz):
     return g1 * distribution(alpha, hz / norm) / (4.0 * wiz)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
@@ -115,7 +115,7 @@ def pdf(params, wix, wiy, wiz, wox, woy, woz):
     return q * specular_pdf(params, wix, wiy, wiz, wox, woy, woz) + (1.0 - q) * woz / math.pi
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def visible_normal(alpha, wix, wiy, wiz, u1, u2):
     """A microfacet normal drawn from GGX's distribution of visible normals seen from wi (Heitz
     2018, listing 1)."""
@@ -155,7 +155,7 @@ def visible_normal(alpha, wix, wiy, wiz, u1, u2):
     return hx * hn, hy * hn, hz * hn
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(params, wix, wiy, wiz, u1, u2):
     if wiz <= 0.0:
         return 0.0, 0.0, 1.0, 0.0

@@ -22,12 +22,12 @@ import math
 from numba import njit
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def chandrasekhar_h(gamma, x):
     return (1.0 + 2.0 * x) / (1.0 + 2.0 * gamma * x)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0

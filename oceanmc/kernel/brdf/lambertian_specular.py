@@ -15,7 +15,7 @@ from numba import njit
 from ..geometry import from_angles
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(params, wix, wiy, wiz, u1, u2):
     rho_d = params[0]
     rho_s = params[1]
@@ -30,7 +30,7 @@ def sample(params, wix, wiy, wiz, u1, u2):
     return wox, woy, woz, total
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     """The diffuse part only (the mirror is a delta function; see the module note)."""
     if wiz <= 0.0 or woz <= 0.0:
@@ -38,7 +38,7 @@ def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     return params[0] / math.pi
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     """Density of the diffuse branch (probability 1 - p_s times cos/pi); the mirror branch is
     a point mass of probability p_s, not a density."""

@@ -8,27 +8,27 @@ from numba import njit
 from ..geometry import from_angles
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def reflectance(params, cos_i):
     """Directional-hemispherical reflectance rho_dh(t_i)."""
     return 2.0 * params[0] * max(0.0, cos_i) ** params[1] / (params[1] + 2.0)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(params, wix, wiy, wiz, u1, u2):
     cos_o = u1 ** (1.0 / (params[1] + 2.0))
     wox, woy, woz = from_angles(cos_o, 2.0 * math.pi * u2)
     return wox, woy, woz, reflectance(params, wiz)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
     return params[0] / math.pi * (wiz * woz) ** params[1]
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     if woz <= 0.0:
         return 0.0

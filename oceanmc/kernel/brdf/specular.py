@@ -3,16 +3,16 @@ The BRDF is a delta function, so evaluate and pdf (densities) are 0 for every fi
 from numba import njit
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(params, wix, wiy, wiz, u1, u2):
     return -wix, -wiy, wiz, params[0]
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     return 0.0

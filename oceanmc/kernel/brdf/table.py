@@ -22,7 +22,7 @@ from ..models import BRDF_TABLE_AT
 HEADER = 8
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def locate(params, start, n, x):
     """(index of the node at or below x, fraction towards the next) on nodes params[start:start+n],
     clamped to the node range; a single node gives (0, 0)."""
@@ -44,7 +44,7 @@ def locate(params, start, n, x):
     return lo, (x - x0) / (params[start + lo + 1] - x0)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0

@@ -9,7 +9,7 @@ from ..models import PHASE_HG, PHASE_ISOTROPIC, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample_component(model, params, tab_start, tab_len, tab_psi, tab_q, tab_cdf, u):
     if model == PHASE_HG:
         return henyey_greenstein.sample(params, u)
@@ -20,7 +20,7 @@ def sample_component(model, params, tab_start, tab_len, tab_psi, tab_q, tab_cdf,
     return isotropic.sample(params, u)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate_component(model, params, tab_start, tab_len, tab_psi, tab_q, cos_psi):
     if model == PHASE_HG:
         return henyey_greenstein.evaluate(params, cos_psi)

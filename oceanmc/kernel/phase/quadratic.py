@@ -6,7 +6,7 @@ import math
 from numba import njit
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(params, u):
     """Exact inversion of the CDF F(m) = (m + beta m^3/3 + 1 + beta/3) / (2 + 2 beta/3): the cubic
     m^3 + p m + q = 0 with p = 3/beta > 0 has one real root, taken in its hyperbolic form, which
@@ -22,7 +22,7 @@ def sample(params, u):
     return min(1.0, max(-1.0, m))
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(params, cos_psi):
     beta = params[0]
     return (1.0 + beta * cos_psi * cos_psi) / (2.0 * math.pi * (2.0 + 2.0 * beta / 3.0))

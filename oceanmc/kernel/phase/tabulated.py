@@ -8,7 +8,7 @@ from numba import njit
 EDGE = 1e-12
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def sample(psi, q, cdf, start, length, u):
     lo = start
     hi = start + length - 1
@@ -28,7 +28,7 @@ def sample(psi, q, cdf, start, length, u):
     return math.cos(angle)
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def density(psi, q, start, length, angle):
     """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
     between nodes)."""
@@ -44,7 +44,7 @@ def density(psi, q, start, length, angle):
     return q[lo] + frac * (q[lo + 1] - q[lo])
 
 
-@njit(error_model="numpy", cache=True, inline="always")
+@njit(error_model="numpy", cache=True)
 def evaluate(psi, q, start, length, cos_psi):
     """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
     tends to a finite limit, taken by staying EDGE rad inside the range."""

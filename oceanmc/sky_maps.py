@@ -1,0 +1,227 @@
+"""Sky radiance distributions for the kernel's sky sampler (kernel/sources.py).
+
+Built-in shapes: `uniform`; `cardioidal` = `overcast`, the CIE standard overcast sky
+L(Z) = L_zenith (1 + 2 cos Z)/3 (Moon & Spencer 1942, Illum. Eng. 37, 707; CIE S 011/E:2003
+sky type 1), sampled exactly by rejection; `harrison_coombes`, the clear sky of Harrison &
+Coombes (1988, Solar Energy 41(4), 387-392, Eqs. 3-5; the formula HydroLight's hcnrad routine
+uses):
+
+    L(Z, psi) ~ [1.63 + 53.7 exp(-5.49 psi) + 2.04 cos^2(psi) cos(Z_sun)]
+                x [1 - exp(-0.19 / cos Z)] x [1 - exp(-0.53 / cos Z_sun)]
+
+with Z the zenith angle of the viewed sky element, Z_sun the sun's zenith angle
+(illumination.sun_zenith_deg) and psi (rad) the angle between the viewed element and the sun.
+The direct sun is not part of it (it stays the separate collimated beam).
+
+Sky maps (`sky: {map: FILE}`): the radiance of the sky as seen looking UP at zenith angle
+theta_view and azimuth phi_view, on an equirectangular grid of cells, each of constant radiance:
+  - .npy: a 2-D array (n_theta, n_phi); rows cover theta_view 0..90 deg in equal steps (row 0
+    at the zenith), columns phi_view 0..360 deg in equal steps (column 0 starting at 0);
+  - .npz or HDF5 (.h5, .hdf5): the array `radiance` (or the name given as `dataset`), optionally
+    with `theta_edges_deg` (n_theta + 1, strictly increasing from 0 to 90) and `phi_edges_deg`
+    (n_phi + 1, strictly increasing, spanning exactly 360 deg).
+phi_view is measured in oceanmc's frame: from the horizontal direction in which the sun's rays
+travel (DESIGN.md section 1), so the sun itself is seen at phi_view = 180 deg. A photon coming
+from the viewed element travels the opposite way: theta_travel (from nadir) = theta_view and
+phi_travel = phi_view + 180 deg. The map's absolute scale does not matter: the sky supplies
+diffuse_fraction x Ed0 of the downward irradiance at 0+.
+
+Sampling: photons carry the sky's irradiance, so directions are drawn with probability
+proportional to L cos(theta) dOmega = L sin(theta) cos(theta) dtheta dphi: a row from the
+marginal CDF over rows, a cell within the row from its conditional CDF, then sin^2(theta)
+and phi uniformly within the cell. For a map (piecewise constant) this density is exactly
+proportional to L cos, so every sky photon carries the same weight. Harrison-Coombes is drawn
+from its cell averages on a 1 x 2 deg grid and weighted by L(direction) / L(cell) (the exact
+density is used in the weight), so it is reproduced exactly, not only to the grid.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import config as cfg
+from .kernel import models
+from .phase_tables import TableError
+
+HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
+HC_GAUSS = 8              # Gauss points per cell side for its cell averages
+
+
+def _fail(path, problem: str):
+    raise TableError(f"sky map {path}: {problem}")
+
+
+def _edges(path, data: dict, name: str, n: int, span: tuple[float, float] | None) -> np.ndarray:
+    e = np.asarray(data[name])
+    if not np.issubdtype(e.dtype, np.number):
+        _fail(path, f"{name} is not numeric")
+    e = e.astype(np.float64)
+    if e.ndim != 1 or e.size != n + 1:
+        _fail(path, f"{name} must be one-dimensional with {n + 1} values (one more than the "
+                    f"map's {'rows' if span else 'columns'}), got shape {e.shape}")
+    if not np.all(np.isfinite(e)):
+        _fail(path, f"{name} contains NaN or inf")
+    if np.any(np.diff(e) <= 0.0):
+        bad = int(np.argmin(np.diff(e) > 0.0)) + 1
+        _fail(path, f"{name} must increase strictly ({e[bad]:g} after {e[bad - 1]:g} at index "
+                    f"{bad})")
+    if span is not None and (e[0] != span[0] or e[-1] != span[1]):
+        _fail(path, f"{name} must run from {span[0]:g} to {span[1]:g} deg (the zenith to the "
+                    f"horizon), got {e[0]:g}..{e[-1]:g}")
+    if span is None and not math.isclose(e[-1] - e[0], 360.0, abs_tol=1e-9):
+        _fail(path, f"{name} must span 360 deg, got {e[0]:g}..{e[-1]:g}")
+    return e
+
+
+def read_sky_map(path, dataset: str = "radiance") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(theta_edges_deg, phi_edges_deg, radiance (n_theta, n_phi)) of a sky map file, checked;
+    every problem is a TableError naming the file."""
+    path = Path(str(path))
+    if not path.is_file():
+        _fail(path, "no such file")
+    if path.stat().st_size == 0:
+        _fail(path, "is empty")
+    suffix = path.suffix.lower()
+    data: dict[str, np.ndarray] = {}
+    if suffix == ".npy":
+        try:
+            data[dataset] = np.load(path, allow_pickle=False)
+        except (OSError, ValueError, EOFError) as exc:
+            _fail(path, f"cannot read it as .npy ({exc})")
+    elif suffix == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                data = {k: np.asarray(z[k]) for k in z.files}
+        except (OSError, ValueError, EOFError) as exc:
+            _fail(path, f"cannot read it as .npz ({exc})")
+    elif suffix in (".h5", ".hdf5", ".he5"):
+        import h5py
+        try:
+            with h5py.File(path, "r") as h5:
+                data = {k: np.asarray(h5[k][()]) for k in h5.keys()
+                        if isinstance(h5[k], h5py.Dataset)}
+        except (OSError, ValueError, TypeError) as exc:
+            _fail(path, f"cannot read it as HDF5 ({exc})")
+    else:
+        _fail(path, f"unknown file type {suffix!r}; use .npy, .npz or .h5/.hdf5")
+    if dataset not in data:
+        _fail(path, f"no array {dataset!r} (found: {sorted(data) or 'nothing'})")
+    L = np.asarray(data[dataset])
+    if L.size == 0:
+        _fail(path, f"the array {dataset!r} is empty")
+    if not np.issubdtype(L.dtype, np.number) or np.iscomplexobj(L):
+        _fail(path, f"the array {dataset!r} is not real numbers ({L.dtype})")
+    if L.ndim != 2:
+        _fail(path, f"the array {dataset!r} must be two-dimensional (theta_view rows x phi_view "
+                    f"columns), got shape {L.shape}")
+    L = L.astype(np.float64)
+    if not np.all(np.isfinite(L)):
+        k = np.argwhere(~np.isfinite(L))[0]
+        _fail(path, f"radiance contains NaN or inf (at row {k[0]}, column {k[1]})")
+    if np.any(L < 0.0):
+        k = np.argwhere(L < 0.0)[0]
+        _fail(path, f"negative radiance {L[k[0], k[1]]:g} at row {k[0]}, column {k[1]}")
+    n_t, n_p = L.shape
+    theta = _edges(path, data, "theta_edges_deg", n_t, (0.0, 90.0)) \
+        if "theta_edges_deg" in data else np.linspace(0.0, 90.0, n_t + 1)
+    phi = _edges(path, data, "phi_edges_deg", n_p, None) \
+        if "phi_edges_deg" in data else np.linspace(0.0, 360.0, n_p + 1)
+    weight = np.sin(np.radians(theta[1:])) ** 2 - np.sin(np.radians(theta[:-1])) ** 2
+    if not np.any(L * weight[:, None] > 0.0):
+        _fail(path, "the sky is dark everywhere (no radiance above the horizon); use "
+                    "diffuse_fraction: 0 for no sky")
+    return theta, phi, L
+
+
+def harrison_coombes(cos_zenith, cos_psi, cos_sun):
+    """Harrison & Coombes (1988) clear-sky radiance (relative units) of a sky element at zenith
+    angle acos(cos_zenith), at the angle acos(cos_psi) from the sun at zenith acos(cos_sun)."""
+    cos_zenith = np.asarray(cos_zenith, dtype=np.float64)
+    cos_psi = np.clip(np.asarray(cos_psi, dtype=np.float64), -1.0, 1.0)
+    psi = np.arccos(cos_psi)
+    with np.errstate(divide="ignore"):
+        horizon = 1.0 - np.exp(-0.19 / np.maximum(cos_zenith, 0.0))
+    return ((1.63 + 53.7 * np.exp(-5.49 * psi) + 2.04 * cos_psi ** 2 * cos_sun) * horizon
+            * (1.0 - math.exp(-0.53 / cos_sun)))
+
+
+def sun_travel(sun_zenith_deg: float) -> np.ndarray:
+    t = math.radians(sun_zenith_deg)
+    return np.array([math.sin(t), 0.0, math.cos(t)])
+
+
+def harrison_coombes_cells(sun_zenith_deg: float, n_t: int = HC_GRID[0], n_p: int = HC_GRID[1],
+                           m: int = HC_GAUSS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(theta_edges_deg, phi_edges_deg, cell averages of L weighted by cos dOmega) of the
+    Harrison-Coombes sky on a view-direction grid (sun seen at phi_view = 180 deg)."""
+    theta = np.linspace(0.0, 90.0, n_t + 1)
+    phi = np.linspace(0.0, 360.0, n_p + 1)
+    x, w = np.polynomial.legendre.leggauss(m)
+    x, w = 0.5 * (x + 1.0), 0.5 * w
+    s_edges = np.sin(np.radians(theta)) ** 2
+    # Gauss points in s = sin^2(theta_view) (cos dOmega = ds dphi / 2) and phi within each cell
+    s = s_edges[:-1, None] + x[None, :] * np.diff(s_edges)[:, None]          # (n_t, m)
+    ph = np.radians(phi[:-1, None] + x[None, :] * np.diff(phi)[:, None])      # (n_p, m)
+    sin_t = np.sqrt(s)
+    cos_t = np.sqrt(1.0 - s)
+    sun = sun_travel(sun_zenith_deg)
+    # travel direction u = (-sin cos phi_view, -sin sin phi_view, cos)
+    cos_psi = (-sin_t[:, None, :, None] * np.cos(ph)[None, :, None, :] * sun[0]
+               - sin_t[:, None, :, None] * np.sin(ph)[None, :, None, :] * sun[1]
+               + cos_t[:, None, :, None] * sun[2])
+    L = harrison_coombes(cos_t[:, None, :, None], cos_psi, sun[2])
+    avg = np.einsum("abkj,k,j->ab", L, w, w)
+    return theta, phi, avg
+
+
+def sky_fields(ill: cfg.Illumination) -> dict:
+    """The SceneArrays sky fields for the configured sky."""
+    empty = {"sky_s_edges": np.zeros(2), "sky_phi_edges": np.zeros(2),
+             "sky_row_cdf": np.ones(1), "sky_cell_cdf": np.ones((1, 1)),
+             "sky_cell_L": np.ones((1, 1)), "sky_params": np.zeros(8)}
+    sky = ill.sky
+    if isinstance(sky, str) and sky in ("uniform", "cardioidal", "overcast"):
+        model = models.SKY_UNIFORM if sky == "uniform" else models.SKY_CARDIOIDAL
+        return dict(empty, sky_model=model)
+    if isinstance(sky, str):
+        assert sky == "harrison_coombes", sky
+        theta, phi, L = harrison_coombes_cells(ill.sun_zenith_deg)
+        model = models.SKY_HARRISON_COOMBES
+    else:
+        theta, phi, L = read_sky_map(sky.map, sky.dataset)
+        model = models.SKY_MAP
+    return dict(sampling_tables(theta, phi, L), sky_model=model,
+                sky_params=sky_parameters(ill.sun_zenith_deg))
+
+
+def sky_parameters(sun_zenith_deg: float) -> np.ndarray:
+    """(sun travel x, y, z, cos sun zenith, 0...) for the kernel's Harrison-Coombes radiance."""
+    sun = sun_travel(sun_zenith_deg)
+    return np.array([sun[0], sun[1], sun[2], sun[2], 0.0, 0.0, 0.0, 0.0])
+
+
+def sampling_tables(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray) -> dict:
+    """Marginal CDF over rows and conditional CDFs within rows of the cell probabilities
+    L x integral of cos dOmega (= L (sin^2 theta_hi - sin^2 theta_lo) dphi / 2)."""
+    s_edges = np.sin(np.radians(theta_deg)) ** 2
+    s_edges[0] = 0.0
+    s_edges[-1] = 1.0
+    phi = np.radians(phi_deg)
+    mass = L * np.diff(s_edges)[:, None] * np.diff(phi)[None, :] * 0.5
+    rows = mass.sum(axis=1)
+    row_cdf = np.cumsum(rows) / rows.sum()
+    last = int(np.nonzero(rows > 0.0)[0][-1])
+    row_cdf[last:] = 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cell_cdf = np.cumsum(mass, axis=1) / rows[:, None]
+    cell_cdf[rows <= 0.0, :] = 1.0
+    for i in range(len(rows)):
+        if rows[i] > 0.0:
+            k = int(np.nonzero(mass[i] > 0.0)[0][-1])
+            cell_cdf[i, k:] = 1.0
+    return {"sky_s_edges": s_edges, "sky_phi_edges": phi, "sky_row_cdf": row_cdf,
+            "sky_cell_cdf": np.ascontiguousarray(cell_cdf),
+            "sky_cell_L": np.ascontiguousarray(L.astype(np.float64))}
+
