@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-$(shell cksum pyproject.toml | cut -d' ' -f1)
 
-.PHONY: run test validate clean
+.PHONY: run test validate bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -22,6 +22,9 @@ test: $(STAMP)
 
 validate: $(STAMP)
 	$(BIN)/oceanmc validate -o validation
+
+bench: $(STAMP)
+	$(BIN)/oceanmc bench -o benchmarks
 
 clean:
 	rm -rf $(VENV) results .pytest_cache

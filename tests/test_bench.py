@@ -1,0 +1,29 @@
+"""`oceanmc bench --quick` runs end to end and writes its report (numbers are meaningless at
+these counts; the real run is committed in benchmarks/)."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from conftest import REPO
+
+
+def test_quick_bench_writes_report(tmp_path):
+    bare_walk = REPO.parent / "shared" / "bench" / "bare_walk.py"
+    args = [sys.executable, "-m", "oceanmc", "bench", "--quick", "-o", str(tmp_path / "b"),
+            "--configs", str(REPO / "configs")]
+    if bare_walk.is_file():
+        args += ["--bare-walk", str(bare_walk)]
+    done = subprocess.run(args, capture_output=True, text=True, timeout=900, cwd=REPO)
+    assert done.returncode == 0, done.stderr[-3000:]
+    data = json.loads((tmp_path / "b" / "bench.json").read_text())
+    assert data["speed_ceiling"]["oceanmc_1t"] > 0
+    assert {row["variant"] for row in data["features"]} >= {"no tallies at all",
+                                                            "+ local nadir-cap estimate"}
+    scenes = {curve["scene"] for curve in data["error_vs_time"]}
+    assert scenes == {"bare walk", "clear ocean", "shallow sand", "Snell's window"}
+    snell = next(c for c in data["error_vs_time"] if c["scene"] == "Snell's window")
+    assert snell["reference"] == "analytic"
+    assert all(abs(row["z"]) < 5 for row in snell["rows"]), snell["rows"]
+    assert (tmp_path / "b" / "error_vs_time.png").stat().st_size > 10_000
+    assert "Speed ceiling" in (tmp_path / "b" / "bench.md").read_text()
