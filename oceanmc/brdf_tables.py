@@ -363,10 +363,11 @@ def check_energy(rho_dh: np.ndarray, theta_i: np.ndarray, phi_i: np.ndarray, wha
             "parameters, or set bottom.allow_unphysical: true to run it anyway")
 
 
-def bottom_arrays(bottom) -> tuple[int, np.ndarray]:
+def bottom_arrays(bottom, diagnostics: dict | None = None) -> tuple[int, np.ndarray]:
     """(model id, packed parameter array) for a validated bottom config; reads a measured table,
     builds the general sampler's tables where needed and runs the physical checks. Raises
-    TableError / ConfigError naming the model (and file) and the worst incidence angle."""
+    TableError / ConfigError naming the model (and file) and the worst incidence angle.
+    diagnostics, if given, receives the incident nodes and the cell integrals."""
     model = MODEL_IDS[bottom.model]
     params = np.zeros(models.BRDF_HEADER)
     sc = scalars(bottom)
@@ -389,12 +390,14 @@ def bottom_arrays(bottom) -> tuple[int, np.ndarray]:
     tabulated = uses_tabulated_sampler(bottom)
     numeric_check = not allow and bottom.model in ("ggx", "hapke", "table",
                                                    "lambertian_specular")
-    if not (tabulated or numeric_check):
+    if not (tabulated or numeric_check or diagnostics is not None):
         return model, params
     anisotropic = table is not None and table["phi_i"] is not None
     theta_i, phi_i, n_t, n_p = incident_grid(anisotropic)
     gx, gw = gauss01(gauss_points(bottom))
     cells, f_min, where = ktables.cell_integrals(model, params, theta_i, phi_i, n_t, n_p, gx, gw)
+    if diagnostics is not None:
+        diagnostics.update(theta_i=theta_i, phi_i=phi_i, cells=cells)
     if numeric_check:
         if f_min < 0.0:
             raise ConfigError(
@@ -414,12 +417,10 @@ def bottom_arrays(bottom) -> tuple[int, np.ndarray]:
 def tabulated_rho_dh(bottom) -> tuple[np.ndarray, np.ndarray]:
     """(theta_i nodes in deg, rho_dh at them) from the sampler grid's cell integrals (for
     reports and tests; isotropic models)."""
-    model, params = bottom_arrays(bottom.model_copy(update={"allow_unphysical": True})
-                                  if hasattr(bottom, "allow_unphysical") else bottom)
-    theta_i, phi_i, n_t, n_p = incident_grid(False)
-    gx, gw = gauss01(gauss_points(bottom))
-    cells = ktables.cell_integrals(model, params, theta_i, phi_i, n_t, n_p, gx, gw)[0]
-    return np.degrees(theta_i), cells.sum(axis=(1, 2, 3))
+    out: dict = {}
+    bottom_arrays(bottom.model_copy(update={"allow_unphysical": True})
+                  if hasattr(bottom, "allow_unphysical") else bottom, out)
+    return np.degrees(out["theta_i"]), out["cells"].sum(axis=(1, 2, 3))
 
 
 def has_mirror(bottom) -> bool:

@@ -12,10 +12,12 @@ goes straight back towards the source, the hot spot):
   f = (w / 4 pi) / (mu0 + mu) [ (1 + B(g)) P(g) + H(mu0) H(mu) - 1 ]      (1/sr)
   P(g) = (1 - xi^2) / (1 + 2 xi cos g + xi^2)^(3/2)
   B(g) = B0 / (1 + tan(g/2) / h)
-  H(x) = (1 + 2x) / (1 + 2 sqrt(1 - w) x)   (Hapke's 1981 approximation)
-f is symmetric in wi and wo (reciprocal) and non-negative (H >= 1). The opposition term adds
-light that Hapke's model does not take from elsewhere, so rho_dh can exceed 1 for bright grains
-and a strong surge: the scene check reports it. No analytic inverse exists: the general
+  H(x) = 1 / (1 - w x [r0 + (1 - 2 r0 x)/2 ln((1 + x)/x)]), r0 = (1 - g)/(1 + g),
+  g = sqrt(1 - w)   (Hapke 2002, Icarus 157, 523, Eq. 13: within 1% of Chandrasekhar's H)
+f is symmetric in wi and wo (reciprocal) and non-negative (H >= 1). With w = 1 and no surge
+rho_dh is 0.986-0.991 (exactly 1 with the exact H; the 1981 form (1 + 2x)/(1 + 2 g x) gave up to
+1.040). The opposition term adds light that Hapke's model does not take from elsewhere, so
+rho_dh can exceed 1 for bright grains and a strong surge: the scene check reports it. No analytic inverse exists: the general
 tabulated sampler (general.py) samples it."""
 import math
 
@@ -23,8 +25,11 @@ from numba import njit
 
 
 @njit(error_model="numpy", cache=True)
-def chandrasekhar_h(gamma, x):
-    return (1.0 + 2.0 * x) / (1.0 + 2.0 * gamma * x)
+def chandrasekhar_h(w, r0, x):
+    """Hapke's (2002) approximation to Chandrasekhar's H function for isotropic scatterers."""
+    if x <= 0.0:
+        return 1.0
+    return 1.0 / (1.0 - w * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * math.log((1.0 + x) / x)))
 
 
 @njit(error_model="numpy", cache=True)
@@ -43,5 +48,6 @@ def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     else:
         b = b0 / (1.0 + math.sqrt((1.0 - cos_g) / (1.0 + cos_g)) / h)
     gamma = math.sqrt(max(0.0, 1.0 - w))
-    multiple = chandrasekhar_h(gamma, wiz) * chandrasekhar_h(gamma, woz) - 1.0
+    r0 = (1.0 - gamma) / (1.0 + gamma)
+    multiple = chandrasekhar_h(w, r0, wiz) * chandrasekhar_h(w, r0, woz) - 1.0
     return w / (4.0 * math.pi) / (wiz + woz) * ((1.0 + b) * p + multiple)
