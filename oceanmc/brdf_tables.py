@@ -15,10 +15,12 @@ density proportional to cos(theta_o). An incidence between nodes draws from one 
 neighbouring nodes with the linear-interpolation weights, and the packet's weight is
 f cos / pdf with the exact mixture pdf. The expectation of the weight is therefore rho_dh(wi)
 exactly, whatever the grid; the grid sets only how constant the weight is. Measured by
-tests/test_brdf_models.py: Lambertian through this path gives weight == rho to 1e-12;
-Minnaert k = 1.5 a weight spread (standard deviation / mean) below 6%; Hapke, GGX (alpha 0.3)
-and measured tables below 15-35%; the tabulated rho_dh at the nodes agrees with independent
-quadrature to better than 1e-4 for smooth models.
+tests/test_brdf_models.py (200,000 samples at 0, 45 and 76 deg): Lambertian through this path
+gives weight == rho to 1e-12; the weight's spread (standard deviation / mean) is 2% for Minnaert
+k = 1.5, 0.5-1.7% for Hapke and tables, 5-11% for GGX (alpha = 0.15) up to 45 deg and 43% at
+76 deg (its lobe narrows towards the horizon); the mean weight matched rho_dh from independent
+quadratures within |z| < 3 everywhere. The tabulated rho_dh at the nodes agrees with the closed
+forms to 1e-6 (Minnaert) and 1e-5 (GGX up to 70 deg, 1e-3 at grazing incidence).
 
 Physical checks (unless bottom.allow_unphysical): f >= 0 at every quadrature point, reciprocity
 f(i, o) = f(o, i) on a grid of direction pairs (relative tolerance 1e-6 for analytic models; for

@@ -11,8 +11,8 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import yaml
-from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
-                      model_validator)
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
+                      field_validator, model_validator)
 
 
 class ConfigError(ValueError):
@@ -165,8 +165,11 @@ class Illumination(_Strict):
     Ed0: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
-    sky: Union[Literal["uniform", "cardioidal", "overcast", "harrison_coombes"], SkyMap] \
-        = "uniform"
+    sky: Annotated[Union[Annotated[Literal["uniform", "cardioidal", "overcast",
+                                           "harrison_coombes"], Tag("sky_name")],
+                         Annotated[SkyMap, Tag("SkyMap")]],
+                   Discriminator(lambda v: "SkyMap" if isinstance(v, (dict, SkyMap))
+                                 else "sky_name")] = "uniform"
 
 
 class Surface(_Strict):
@@ -356,7 +359,8 @@ class SceneConfig(_Strict):
         if not deep and self.bottom.model == "none":
             raise ValueError("bottom.model = 'none' needs an infinitely deep last layer "
                              "(thickness_m: .inf); a finite water column needs a bottom "
-                             "(black, lambertian, minnaert, specular)")
+                             "(black, lambertian, minnaert, specular, lambertian_specular, "
+                             "ggx, hapke, table)")
         depth = self.water.depth_m
         for d in self.tallies.depths_m:
             if d > depth * (1.0 + 1e-12):
@@ -401,7 +405,7 @@ def _key_path(loc: tuple) -> str:
         elif part in {"isotropic", "rayleigh", "pure_water", "henyey_greenstein", "two_term_hg",
                       "fournier_forand", "petzold", "table", "mixture", "none", "black",
                       "lambertian", "minnaert", "specular", "lambertian_specular", "ggx",
-                      "hapke", "SkyMap"} or str(part).startswith(("list[", "literal[")):
+                      "hapke", "SkyMap", "sky_name"} or str(part).startswith(("list[", "literal[")):
             continue  # pydantic's union-branch tags are not keys the user wrote
         else:
             path += ("." if path else "") + str(part)

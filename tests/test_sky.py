@@ -1,0 +1,336 @@
+"""Sky radiance: maps from files, the Harrison & Coombes (1988) clear sky, the overcast alias.
+
+The sampler draws sky photon directions with probability proportional to L cos dOmega (rows from
+the marginal CDF, cells from the conditional CDF): chi-square of the drawn cells against
+L (sin^2 theta_hi - sin^2 theta_lo) dphi / 2 computed here (Bonferroni over the tests), the
+view -> travel convention (phi_travel = phi_view + 180 deg) on a one-cell map, and Harrison-
+Coombes' weighted histogram against an independent quadrature of its formula. Through the
+engine: a uniform map reproduces `sky: uniform` (fluxes and radiances within standard errors),
+and Harrison-Coombes gives the surface reflectance and the sky radiance quads of the formula.
+Bad files give one ConfigError naming the file and the problem.
+"""
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+import oceanmc
+from oceanmc import scene, sky_maps
+from oceanmc.config import ConfigError, load_config
+from oceanmc.kernel.sources import sky_many
+
+from stats_helpers import (assert_chi2, assert_same, assert_z, batch_mean_se, fresnel_reference)
+
+N = 1.34
+N_CHI2 = 6          # chi-square tests in this file (Bonferroni)
+
+
+def base(sky, **over):
+    config = {"photons": 2000, "batches": 4, "seed": 1,
+              "illumination": {"Ed0": 1.0, "sun_zenith_deg": 40.0, "diffuse_fraction": 1.0,
+                               "sky": sky},
+              "surface": {"model": "flat", "n_water": N},
+              "water": {"layers": [{"thickness_m": 1.0, "a": 0.0, "b": 0.0}]},
+              "bottom": {"model": "black"},
+              "tallies": {"depths_m": [0.0], "nadir_estimator": "crossing"}}
+    config.update(over)
+    return config
+
+
+def draw(sky, n, seed=1, **over):
+    sc, _ = scene.build(load_config(base(sky, **over)))
+    return sky_many(sc, n, seed)
+
+
+def view_angles(u):
+    """(theta_view, phi_view in [0, 360)) in deg of the sky element a photon comes from."""
+    theta = np.degrees(np.arccos(np.clip(u[:, 2], -1.0, 1.0)))
+    phi = np.mod(np.degrees(np.arctan2(-u[:, 1], -u[:, 0])), 360.0)
+    return theta, phi
+
+
+def cell_mass(theta_edges, phi_edges, L):
+    """L x integral of cos dOmega over each cell, normalised."""
+    s = np.sin(np.radians(theta_edges)) ** 2
+    m = L * np.diff(s)[:, None] * np.radians(np.diff(phi_edges))[None, :] / 2.0
+    return m / m.sum()
+
+
+# --- the sampler ------------------------------------------------------------------------------
+
+def test_map_sampling(tmp_path):
+    """A map with structure, zeros and uneven cells (HDF5 with edges): the drawn cells follow
+    L cos dOmega; weight factors are 1; directions travel downward."""
+    rng = np.random.default_rng(4)
+    theta_e = np.array([0.0, 10.0, 25.0, 35.0, 50.0, 60.0, 70.0, 80.0, 86.0, 90.0])
+    phi_e = np.linspace(-180.0, 180.0, 25)
+    L = rng.uniform(0.2, 3.0, size=(9, 24))
+    L[3, 5:9] = 0.0
+    L[7, :] = 0.0
+    L[2, 12] = 40.0
+    path = tmp_path / "sky.h5"
+    with h5py.File(path, "w") as h5:
+        h5["radiance"] = L
+        h5["theta_edges_deg"] = theta_e
+        h5["phi_edges_deg"] = phi_e
+    n = 300_000
+    u = draw({"map": str(path)}, n)
+    assert np.all(u[:, 3] == 1.0)
+    assert np.all(u[:, 2] > 0.0)
+    np.testing.assert_allclose(np.linalg.norm(u[:, :3], axis=1), 1.0, atol=1e-12)
+    t, p = view_angles(u)
+    p = np.where(p >= 180.0, p - 360.0, p)
+    counts = np.histogram2d(t, p, bins=[theta_e, phi_e])[0]
+    probs = cell_mass(theta_e, phi_e, L)
+    assert_chi2(counts, probs, rel_cap=None, p_min=1e-3 / N_CHI2, what="map cells")
+    assert_chi2(counts.sum(axis=1), probs.sum(axis=1), p_min=1e-3 / N_CHI2,
+                what="map rows (theta marginal)")
+    assert_chi2(counts.sum(axis=0), probs.sum(axis=0), p_min=1e-3 / N_CHI2, min_cap_count=5000,
+                what="map columns (phi marginal)")
+
+
+def test_view_to_travel_convention(tmp_path):
+    """One bright cell seen at theta_view 30-34 deg, phi_view 176-184 deg (towards the sun, whose
+    rays travel at phi = 0): every sky photon travels at theta 30-34 deg from nadir with phi
+    within 4 deg of 0, i.e. along with the sun's rays."""
+    L = np.zeros((45, 90))
+    L[15:17, 44:46] = 1.0               # rows 2 deg, columns 4 deg
+    np.save(tmp_path / "spot.npy", L)
+    u = draw({"map": str(tmp_path / "spot.npy")}, 20_000)
+    theta = np.degrees(np.arccos(u[:, 2]))
+    phi = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+    assert theta.min() >= 30.0 - 1e-9 and theta.max() <= 34.0 + 1e-9
+    assert np.abs(phi).max() <= 4.0 + 1e-9
+    assert np.mean(phi > 0) == pytest.approx(0.5, abs=0.02)
+
+
+def hc_radiance(u, sun_zenith_deg):
+    """Harrison & Coombes (1988) Eqs. 3-5 for travel directions u (rows), written here."""
+    s = math.radians(sun_zenith_deg)
+    cos_psi = np.clip(u[..., 0] * math.sin(s) + u[..., 2] * math.cos(s), -1.0, 1.0)
+    psi = np.arccos(cos_psi)
+    return ((1.63 + 53.7 * np.exp(-5.49 * psi) + 2.04 * cos_psi ** 2 * math.cos(s))
+            * (1.0 - np.exp(-0.19 / u[..., 2])) * (1.0 - math.exp(-0.53 / math.cos(s))))
+
+
+def travel_rule(theta_lo, theta_hi, phi_lo, phi_hi, nt=64, nphi=64):
+    """Gauss rule over travel directions in a (theta, phi) box (deg): directions and weights
+    of dOmega."""
+    x, w = np.polynomial.legendre.leggauss(nt)
+    mu_a, mu_b = math.cos(math.radians(theta_hi)), math.cos(math.radians(theta_lo))
+    mu = mu_a + (mu_b - mu_a) * (x + 1) / 2
+    wm = w * (mu_b - mu_a) / 2
+    y, v = np.polynomial.legendre.leggauss(nphi)
+    ph = math.radians(phi_lo) + math.radians(phi_hi - phi_lo) * (y + 1) / 2
+    wp = v * math.radians(phi_hi - phi_lo) / 2
+    M, P = np.meshgrid(mu, ph, indexing="ij")
+    u = np.stack([np.sqrt(1 - M ** 2) * np.cos(P), np.sqrt(1 - M ** 2) * np.sin(P), M], -1)
+    return u, np.outer(wm, wp)
+
+
+def hc_cos_integral(sun, theta_lo, theta_hi, phi_lo, phi_hi, weight=lambda mu: 1.0, split=4):
+    """Integral of L cos (x weight(cos)) dOmega over a travel-direction box, with the box split
+    so the circumsolar cusp (phi = 0, theta = sun) falls on sub-box edges."""
+    ts = np.linspace(theta_lo, theta_hi, split + 1)
+    ps = np.linspace(phi_lo, phi_hi, split + 1)
+    if theta_lo < sun < theta_hi:
+        ts = np.unique(np.append(ts, sun))
+    if phi_lo < 0.0 < phi_hi:
+        ps = np.unique(np.append(ps, 0.0))
+    total = 0.0
+    for a, b in zip(ts[:-1], ts[1:]):
+        for c, d in zip(ps[:-1], ps[1:]):
+            u, w = travel_rule(a, b, c, d)
+            total += np.sum(w * hc_radiance(u, sun) * u[..., 2] * weight(u[..., 2]))
+    return total
+
+
+def test_harrison_coombes_sampling():
+    """Weighted directions (weight factor L / L_cell) against the integral of L cos over coarse
+    bins of the formula; E[factor] = 1 (the proposal's normalisation, from its 8 x 8 Gauss cell
+    averages, is exact to the sampling precision)."""
+    sun = 40.0
+    n = 400_000
+    u = draw("harrison_coombes", n, seed=3, illumination={
+        "Ed0": 1.0, "sun_zenith_deg": sun, "diffuse_fraction": 1.0, "sky": "harrison_coombes"})
+    m = u[:, 3]
+    mean, se = m.mean(), m.std(ddof=1) / math.sqrt(n)
+    assert_z(mean, 1.0, se, rel_max=1e-3, what="Harrison-Coombes mean weight factor")
+    t_e = np.arange(0.0, 90.1, 10.0)
+    p_e = np.arange(-180.0, 180.1, 30.0)
+    theta = np.degrees(np.arccos(u[:, 2]))
+    phi = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+    est = np.histogram2d(theta, phi, bins=[t_e, p_e], weights=m)[0] / n
+    est_sq = np.histogram2d(theta, phi, bins=[t_e, p_e], weights=m * m)[0] / n
+    est_se = np.sqrt(np.maximum(est_sq - est ** 2, 0.0) / n)
+    total = hc_cos_integral(sun, 0.0, 90.0, -180.0, 180.0, split=12)
+    ref = np.array([[hc_cos_integral(sun, a, b, c, d, split=2) for c, d in zip(p_e[:-1],
+                                                                                p_e[1:])]
+                    for a, b in zip(t_e[:-1], t_e[1:])]) / total
+    z = assert_z(est, ref, est_se, rel_max=0.08, what="Harrison-Coombes weighted bins")
+    # the brightest bin per solid angle is beside the sun (phi of travel -30..30 deg)
+    per_sr = ref / -np.diff(np.cos(np.radians(t_e)))[:, None]
+    assert np.unravel_index(np.argmax(per_sr), ref.shape)[1] in (5, 6)
+    print(f"Harrison-Coombes: E[factor] = {mean:.5f} +- {se:.1e}; weighted bins max |z| "
+          f"{np.max(np.abs(z)):.2f}; factor spread {m.std() / mean:.3f}")
+
+
+def test_harrison_coombes_cell_quadrature():
+    """The proposal's cell averages (8 x 8 Gauss per 1 x 2 deg cell) integrate L cos to 1e-6 of
+    the finely split quadrature above (what makes E[factor] = 1)."""
+    theta, phi, L = sky_maps.harrison_coombes_cells(40.0)
+    s = np.sin(np.radians(theta)) ** 2
+    table = np.sum(L * np.diff(s)[:, None] * np.radians(np.diff(phi))[None, :] / 2.0)
+    fine = hc_cos_integral(40.0, 0.0, 90.0, -180.0, 180.0, split=12)
+    assert table == pytest.approx(fine, rel=1e-6)
+
+
+# --- the whole engine -------------------------------------------------------------------------
+
+def engine_scene(sky, seed, photons=300_000):
+    return base(sky, photons=photons, batches=20, seed=seed,
+                water={"layers": [{"thickness_m": 1.0, "a": 0.05, "b": 0.2,
+                                   "phase": {"model": "henyey_greenstein", "g": 0.8}}]},
+                bottom={"model": "lambertian", "reflectance": 0.3},
+                tallies={"depths_m": [0.0, 1.0], "nadir_estimator": "crossing"})
+
+
+def compare(a, b, names, what):
+    """Every named quantity of two independent runs agrees within their standard errors
+    (Bonferroni over all compared values); returns the largest |z|."""
+    parts = [[], [], [], []]
+    for name in names:
+        ma, sa = batch_mean_se(a.quantities[name].batches)
+        mb, sb = batch_mean_se(b.quantities[name].batches)
+        for k, v in enumerate((ma, sa, mb, sb)):
+            parts[k].append(np.atleast_1d(v).ravel())
+    ma, sa, mb, sb = (np.concatenate(p) for p in parts)
+    keep = (sa > 0) | (sb > 0)
+    z = assert_same(mb[keep], sb[keep], ma[keep], sa[keep], dof=19, what=what)
+    return float(np.max(np.abs(z)))
+
+
+def fresnel_air_water(mu):
+    """Unpolarized Fresnel reflectance from air into water at incidence cosines mu (array),
+    checked against stats_helpers.fresnel_reference below."""
+    mu = np.clip(mu, 1e-12, 1.0)
+    ct = np.sqrt(1.0 - (1.0 - mu ** 2) / N ** 2)
+    rs = (mu - N * ct) / (mu + N * ct)
+    rp = (ct - N * mu) / (ct + N * mu)
+    return 0.5 * (rs ** 2 + rp ** 2)
+
+
+def test_uniform_map_reproduces_uniform_sky(tmp_path):
+    np.save(tmp_path / "uniform.npy", np.full((18, 36), 2.5))
+    a = oceanmc.simulate(engine_scene("uniform", seed=1), threads=2)
+    b = oceanmc.simulate(engine_scene({"map": str(tmp_path / "uniform.npy")}, seed=2), threads=2)
+    names = ["Ed", "Eu", "Eod", "Eou", "budget/surface_reflection", "budget/water_leaving",
+             "air/Eu"]
+    worst = compare(a, b, names, "uniform map vs uniform")
+    for name in ("Ed", "Eu", "budget/surface_reflection"):
+        np.testing.assert_allclose(b[name], a[name], rtol=0.01)
+    # radiance quads just above and below the surface (caps once)
+    ra, sa = batch_mean_se(a.quantities["air/radiance"].batches)
+    rb, sb = batch_mean_se(b.quantities["air/radiance"].batches)
+    keep = np.ones(ra.shape, dtype=bool)
+    keep[0, 1:] = keep[-1, 1:] = False
+    z = assert_same(rb[keep], sb[keep], ra[keep], sa[keep], dof=19, what="air radiance quads")
+    print(f"uniform map vs uniform sky: max |z| {max(worst, float(np.max(np.abs(z)))):.2f}")
+
+
+def test_overcast_is_cardioidal():
+    a = oceanmc.simulate(base("overcast", photons=4000), threads=1)
+    b = oceanmc.simulate(base("cardioidal", photons=4000), threads=1)
+    np.testing.assert_array_equal(a.quantities["air/radiance"].batches,
+                                  b.quantities["air/radiance"].batches)
+
+
+def test_harrison_coombes_engine():
+    """Clear water over black: the surface reflects int L cos R dOmega / int L cos dOmega of the
+    Harrison-Coombes sky (independent Fresnel and quadrature), and the downward sky quads at 0+
+    read its quad-averaged radiance, scaled to Ed0."""
+    sun = 40.0
+    r = oceanmc.simulate(base("harrison_coombes", photons=400_000, batches=20, seed=5),
+                         threads=2)
+    total = hc_cos_integral(sun, 0.0, 90.0, -180.0, 180.0, split=12)
+    for t in (0.1, 30.0, 60.0, 85.0):
+        assert fresnel_air_water(np.array(math.cos(math.radians(t)))) == pytest.approx(
+            fresnel_reference(1.0, N, math.radians(t)), rel=1e-12)
+    refl = hc_cos_integral(sun, 0.0, 90.0, -180.0, 180.0, split=12,
+                           weight=fresnel_air_water) / total
+    assert_z(r["budget/surface_reflection"], refl, r.stderr("budget/surface_reflection"),
+             rel_max=0.01, dof=19, what="Harrison-Coombes surface reflectance")
+    edges = r.coords["theta_edges"]
+    phi_e = r.coords["phi_edges"]
+    est, se = batch_mean_se(r.quantities["air/radiance"].batches)
+    ref, use = np.zeros(est.shape), np.zeros(est.shape, dtype=bool)
+    for i in range(1, 9):                       # downward bands 5..85 deg (not the cap, horizon)
+        for j in range(len(phi_e) - 1):
+            u, w = travel_rule(edges[i], edges[i + 1], phi_e[j], phi_e[j + 1], 24, 24)
+            ref[i, j] = np.sum(w * hc_radiance(u, sun)) / np.sum(w) / total
+            use[i, j] = True
+    z = assert_z(est[use], ref[use], se[use], dof=19, rel_max=0.12,
+                 what="Harrison-Coombes sky quads at 0+")
+    print(f"Harrison-Coombes: reflectance {r['budget/surface_reflection']:.5f} +- "
+          f"{r.stderr('budget/surface_reflection'):.1e} vs {refl:.5f}; quads max |z| "
+          f"{np.max(np.abs(z)):.2f}")
+
+
+# --- configuration and bad files --------------------------------------------------------------
+
+def sky_error(path, **kw):
+    with pytest.raises(ConfigError) as err:
+        scene.build(load_config(base(dict({"map": str(path)}, **kw))))
+    return str(err.value)
+
+
+def test_bad_sky_files(tmp_path):
+    np.save(tmp_path / "vector.npy", np.ones(10))
+    np.save(tmp_path / "cube.npy", np.ones((3, 4, 5)))
+    np.save(tmp_path / "neg.npy", -np.ones((3, 4)))
+    np.save(tmp_path / "nan.npy", np.full((3, 4), np.nan))
+    np.save(tmp_path / "dark.npy", np.zeros((3, 4)))
+    np.save(tmp_path / "nothing.npy", np.ones((0, 4)))
+    (tmp_path / "empty.npy").write_bytes(b"")
+    (tmp_path / "junk.npy").write_bytes(b"not a numpy file at all")
+    (tmp_path / "sky.png").write_bytes(b"png")
+    np.savez(tmp_path / "mono.npz", radiance=np.ones((3, 4)),
+             theta_edges_deg=np.array([0.0, 40.0, 30.0, 90.0]))
+    np.savez(tmp_path / "short.npz", radiance=np.ones((3, 4)),
+             theta_edges_deg=np.array([0.0, 45.0, 90.0]))
+    np.savez(tmp_path / "horizon.npz", radiance=np.ones((3, 4)),
+             theta_edges_deg=np.array([0.0, 30.0, 60.0, 80.0]))
+    np.savez(tmp_path / "span.npz", radiance=np.ones((3, 4)),
+             phi_edges_deg=np.array([0.0, 90.0, 180.0, 270.0, 350.0]))
+    np.savez(tmp_path / "other.npz", sky=np.ones((3, 4)))
+    cases = {"missing.npy": "no such file", "empty.npy": "is empty",
+             "junk.npy": "cannot read", "sky.png": "unknown file type",
+             "vector.npy": "two-dimensional", "cube.npy": "two-dimensional",
+             "neg.npy": "negative radiance", "nan.npy": "NaN", "dark.npy": "dark everywhere",
+             "nothing.npy": "empty", "mono.npz": "increase strictly",
+             "short.npz": "4 values", "horizon.npz": "0 to 90", "span.npz": "360",
+             "other.npz": "no array 'radiance'"}
+    for name, words in cases.items():
+        msg = sky_error(tmp_path / name)
+        assert "sky map" in msg and str(tmp_path / name) in msg and words in msg, (name, msg)
+    # another dataset name
+    scene.build(load_config(base({"map": str(tmp_path / "other.npz"), "dataset": "sky"})))
+
+
+def test_sky_config(tmp_path):
+    with pytest.raises(ConfigError, match="'uniform', 'cardioidal', 'overcast' or "
+                                          "'harrison_coombes'"):
+        load_config(base("clear"))
+    with pytest.raises(ConfigError, match="illumination.sky.map: required key is missing"):
+        load_config(base({"file": "x.npy"}))
+    np.save(tmp_path / "sky.npy", np.ones((9, 36)))
+    (tmp_path / "scene.yaml").write_text(
+        "water: {layers: [{thickness_m: 1, a: 0.1, b: 0}]}\nbottom: {model: black}\n"
+        "illumination: {diffuse_fraction: 0.5, sky: {map: sky.npy}}\n")
+    config = load_config(tmp_path / "scene.yaml")
+    assert config.illumination.sky.map == str((tmp_path / "sky.npy").resolve())
+    from oceanmc.config import config_to_yaml
+    import yaml
+    again = load_config(yaml.safe_load(config_to_yaml(config)))
+    assert again.illumination.sky == config.illumination.sky
