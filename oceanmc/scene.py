@@ -232,6 +232,18 @@ def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
         cap_h=float(h[1]), cap_dh=float((h[2] - h[0]) / (2.0 * step)))
 
 
+THETA_LOOKUP_CELLS = 4096
+
+
+def _theta_lookup(mu_edges: np.ndarray) -> np.ndarray:
+    """For each of THETA_LOOKUP_CELLS equal cells of uz in [-1, 1], the band (index into the
+    falling mu_edges) of the cell's top value (see kernel.tally.theta_band_fast)."""
+    top = -1.0 + 2.0 * (np.arange(THETA_LOOKUP_CELLS) + 1) / THETA_LOOKUP_CELLS
+    top = np.minimum(top, 1.0)
+    bands = np.searchsorted(-mu_edges, -top, side="left") - 1
+    return np.clip(bands, 0, len(mu_edges) - 2).astype(np.int64)
+
+
 def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
     """The kernel's view of a validated scene, and the tally grid. Raises TableError (a
     ConfigError) for unusable auxiliary files."""
@@ -298,7 +310,10 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         tab_psi=flat(psi_parts), tab_q=flat(q_parts), tab_cdf=flat(cdf_parts),
         bottom_model=bottom_model, bottom_params=bottom_params,
         theta_mu_edges=_mu_edges(grid.theta_edges),
+        theta_lookup=_theta_lookup(_mu_edges(grid.theta_edges)),
         theta_is_cap=grid.is_cap, n_phi=int(config.tallies.phi_bands),
+        phi_edge_cos=np.cos(np.radians(grid.phi_edges[:-1])),
+        phi_edge_sin=np.sin(np.radians(grid.phi_edges[:-1])),
         tally_radiance=bool(config.tallies.radiance), surface_tally=surface_tally,
         air_level=len(config.tallies.depths_m),
         mu_cut=float(config.tallies.grazing_mu_cut),

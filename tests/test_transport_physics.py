@@ -421,7 +421,7 @@ def test_water_to_air_reflectance():
     radiance just below the surface: uniform upward, L_up = T / (pi (1 - r_wa)); downward
     outside Snell's window equal to it (total internal reflection), inside R(theta) L_up."""
     sun = 30.0
-    r = simulate({"photons": 1_000_000, "batches": 32, "seed": 8,
+    r = simulate({"photons": 4_000_000, "batches": 32, "seed": 8,
                   "illumination": {"Ed0": 1.0, "sun_zenith_deg": sun},
                   "surface": {"model": "flat", "n_water": N},
                   "water": {"layers": [{"thickness_m": 1e-3, "a": 0.0, "b": 0.0}]},
@@ -680,9 +680,10 @@ def test_white_mirror_bottom_terminates(mode, b):
                "water": {"layers": [{"thickness_m": 2.0, "a": 0.0, "b": b,
                                      "phase": {"model": "henyey_greenstein", "g": 0.8}}]},
                "bottom": {"model": "specular", "reflectance": 1.0},
-               "estimator": {"mode": mode}, "tallies": {"depths_m": [0.0, 2.0]}})
+               "estimator": {"mode": mode}, "tallies": {"depths_m": [0.0, 2.0]}},
+              photons=200_000)
     out = r["budget/surface_reflection"] + r["budget/water_leaving"]
-    zr(r, out, 1.0, r.stderr("budget/total"), abs_max=1e-3, what="mirror: all light leaves")
+    zr(r, out, 1.0, r.stderr("budget/total"), abs_max=5e-3, what="mirror: all light leaves")
     assert r["budget/absorbed_bottom"] == 0.0
     assert r["budget/absorbed_layer_1"] == 0.0
 

@@ -19,7 +19,7 @@ SceneArrays = namedtuple("SceneArrays", [
     # bottom
     "bottom_model", "bottom_params",
     # tallies
-    "theta_mu_edges", "theta_is_cap", "n_phi", "tally_radiance", "surface_tally", "air_level",
+    "theta_mu_edges", "theta_lookup", "theta_is_cap", "n_phi", "phi_edge_cos", "phi_edge_sin", "tally_radiance", "surface_tally", "air_level",
     "mu_cut", "level_z", "level_tau", "plane_tau",
     # local estimates: upward in-water directions (n, 3), t/n^2 for each at 0+
     "local_estimates", "le_dirs", "le_water", "le_air_factor",

@@ -2,10 +2,10 @@
 water and off the bottom, until they leave, are absorbed or lose Russian roulette.
 
 Estimator (sc.analog False, the default): implicit capture (a collision keeps the packet and
-multiplies its weight by the single-scattering albedo), expected-value splitting at the surface
-(the reflected part w R and the transmitted part w (1 - R) are both followed or tallied: the one
-that leaves the water is scored and ends, the other goes on) and at the bottom (weight times
-rho_dh), exact exponential attenuation in layers that do not scatter, and unbiased Russian
+multiplies its weight by the single-scattering albedo), expected values at the surface (light
+from the air: the reflected part w R is scored and the packet enters with w (1 - R); light from
+the water: the leaving part w (1 - R) is scored, and the packet goes on, reflected, with
+probability R and weight w), weight times rho_dh at the bottom, exact exponential attenuation in layers that do not scatter, and unbiased Russian
 roulette below sc.roulette_weight. Analog mode decides each of these with a random draw instead.
 Either way every quantity has the same expectation; only the variance differs.
 
@@ -55,9 +55,10 @@ def survives_roulette(sc, w):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
-    """Follows one packet that arrives at the surface from the air; returns its scattering count.
-    beam: it belongs to the collimated solar beam (until it scatters or meets a diffuse bottom)."""
+def enter_water(sc, w, ux, uy, uz, beam, flux, radiance, budget):
+    """A packet from the air meets the surface: scores it at 0+ (incoming, and the reflected
+    part), and returns (enters, w, ux, uy, uz) for what goes into the water, scored at 0-.
+    Linear in w: in implicit mode the whole solar beam of a batch enters in one call."""
     score(sc, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
     n = sc.n_water
     if sc.surface_flat:
@@ -66,7 +67,7 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
             if np.random.random() < r:
                 score_air_up(sc, flux, radiance, w, ux, uy, -uz, False, beam)
                 budget[BUDGET_SURFACE_REFLECTION] += w
-                return 0
+                return False, 0.0, ux, uy, uz
         else:
             if r > 0.0:
                 score_air_up(sc, flux, radiance, w * r, ux, uy, -uz, False, beam)
@@ -75,7 +76,15 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
         ux, uy, uz = refract(ux, uy, uz, 1.0 / n, cos_t)
     if sc.surface_tally >= 0:
         score(sc, flux, radiance, sc.surface_tally, w, ux, uy, uz, beam)
+    return True, w, ux, uy, uz
 
+
+@njit(error_model="numpy", cache=True, inline="always")
+def trace_in_water(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
+    """Follows one packet from just below the surface (travelling down) until it leaves, is
+    absorbed or loses roulette; returns its scattering count. beam: it belongs to the collimated
+    solar beam (until it scatters or meets a diffuse bottom)."""
+    n = sc.n_water
     plane_z = sc.plane_z
     bottom_plane = plane_z.shape[0] - 1
     z = 0.0
@@ -170,7 +179,11 @@ def trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
                     score_air_up(sc, flux, radiance, leaving, ox, oy, oz, True, beam)
                     budget[BUDGET_WATER_LEAVING] += leaving
-                w *= r
+                # the reflected part (expected weight w r) goes on by roulette: with
+                # probability r, carrying w, so its expectation is kept while a weak
+                # internally reflected packet costs no more than in an analog walk
+                if r < 1.0 and np.random.random() >= r:
+                    return events
             uz = -uz
             seg = 0
             if level >= 0 and w > 0.0:
@@ -220,15 +233,27 @@ def trace_batch(sc, n_photons, seed, flux, radiance, local, cap, budget):
         n_sky = min(n_photons - 1, max(1, int(round(f * n_photons))))
     w_sky = f * n_photons / n_sky if n_sky > 0 else 0.0
     w_sun = (1.0 - f) * n_photons / (n_photons - n_sky) if n_sky < n_photons else 0.0
+    sun = (sc.sun_sin, 0.0, sc.sun_mu)
+    n_sun = n_photons - n_sky
+    w_sun_in, sx, sy, sz = 0.0, 0.0, 0.0, 1.0
+    if not sc.analog and n_sun > 0:
+        # every implicit-mode sun packet enters the same way: score the beam's entry once
+        _, w_sun_in, sx, sy, sz = enter_water(sc, w_sun * n_sun, sun[0], sun[1], sun[2], True,
+                                              flux, radiance, budget)
+        w_sun_in /= n_sun
     events = 0
     for i in range(n_photons):
         if i < n_sky:
             ux, uy, uz, w = sky_direction(sc)
-            w *= w_sky
+            enters, w, ux, uy, uz = enter_water(sc, w * w_sky, ux, uy, uz, False, flux,
+                                                radiance, budget)
             beam = False
-        else:
-            ux, uy, uz = sc.sun_sin, 0.0, sc.sun_mu
-            w = w_sun
+        elif sc.analog:
+            enters, w, ux, uy, uz = enter_water(sc, w_sun, sun[0], sun[1], sun[2], True, flux,
+                                                radiance, budget)
             beam = True
-        events += trace_photon(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget)
+        else:
+            enters, w, ux, uy, uz, beam = True, w_sun_in, sx, sy, sz, True
+        if enters:
+            events += trace_in_water(sc, w, ux, uy, uz, beam, flux, radiance, local, cap, budget)
     return events

@@ -617,7 +617,7 @@ def case_chandrasekhar(ctx: Ctx) -> None:
                   [ref.chandrasekhar_h(m, w0) for m in mus],
                   [ref.chandrasekhar_h_iterative(m, w0) for m in mus], rtol=1e-7)
 
-    photons = ctx.pick(6_000_000, 150_000)
+    photons = ctx.pick(3_000_000, 150_000)
     w0s = (0.5, 0.8, 0.95)
     ctx.note("Exact directions (theta, phi of travel) for the local estimate: " +
              ", ".join(f"({t:g}, {p:g})" for t, p in CHANDRA_LOCAL) + "; at w0 = 0.8, "
@@ -735,7 +735,7 @@ def case_disort(ctx: Ctx) -> None:
               f"phi = phi0, {peak:.4g}, exceeds that at phi0 + pi, {back:.4g}, tenfold (phi is the "
               f"travel azimuth)", float(peak / back > 10.0), 1.0)
     thickness = 2.0
-    photons = ctx.pick(10_000_000, 200_000)
+    photons = ctx.pick(6_000_000, 200_000)
     ppp = {}
     for (tau, w0, g, sun, rho) in DISORT_SLABS:
         c = tau / thickness
@@ -934,7 +934,7 @@ def case_reciprocity(ctx: Ctx) -> None:
     bands = [(20.0, 30.0), (45.0, 55.0), (65.0, 75.0)]   # zenith angles (sun and view)
     edges = [0.0, 20.0, 30.0, 45.0, 55.0, 65.0, 75.0, 90.0, 105.0, 115.0, 125.0, 135.0, 150.0,
              160.0, 180.0]
-    photons = ctx.pick(8_000_000, 200_000)
+    photons = ctx.pick(5_000_000, 200_000)
     x, w = np.polynomial.legendre.leggauss(3)
     m_est = {}   # (sun band, view band) -> JK over phi columns (4) of band-averaged radiance
     phi_c = None
