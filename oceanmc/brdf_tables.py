@@ -40,7 +40,7 @@ from . import config as cfg
 from .config import ConfigError
 from .kernel import models
 from .kernel.brdf import tables as ktables
-from .phase_tables import TableError
+from .phase_tables import TableError, numeric_rows
 
 ENERGY_TOLERANCE = 1e-3
 ANALYTIC_RECIPROCITY = 1e-6
@@ -82,22 +82,8 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
 def _text_table(path: Path) -> dict[str, np.ndarray]:
     """Rows of (theta_i, theta_r, dphi, f) or (theta_i, phi_i, theta_r, dphi, f), degrees, on a
     complete grid; '#' comments and one header line are skipped."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        _fail(path, f"cannot read it ({exc})")
     rows = []
-    for lineno, line in enumerate(text.splitlines(), 1):
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        fields = line.replace(",", " ").split()
-        try:
-            values = [float(x) for x in fields]
-        except ValueError:
-            if not rows:
-                continue
-            _fail(path, f"line {lineno}: not a number in {line!r}")
+    for lineno, values in numeric_rows(path, "BRDF table"):
         if len(values) not in (4, 5) or (rows and len(values) != len(rows[0])):
             _fail(path, f"line {lineno}: expected 4 columns (theta_i, theta_r, dphi, f) or 5 "
                         f"(theta_i, phi_i, theta_r, dphi, f), got {len(values)}")

@@ -124,6 +124,28 @@ def fournier_forand_table(bb_ratio: float) -> tuple[np.ndarray, np.ndarray, np.n
 
 # --- user tables ------------------------------------------------------------------------------
 
+def numeric_rows(path: Path, what: str) -> list[tuple[int, list[float]]]:
+    """(line number, values) of each data line of a text table: comma or whitespace separated,
+    '#' comments and blank lines skipped, one non-numeric header line allowed before the data.
+    Problems are TableErrors that start with `what` and the file."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TableError(f"{what} {path}: cannot read it ({exc})") from None
+    rows = []
+    for lineno, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        try:
+            rows.append((lineno, [float(x) for x in line.replace(",", " ").split()]))
+        except ValueError:
+            if rows:
+                raise TableError(f"{what} {path}, line {lineno}: not a number in "
+                                 f"{line!r}") from None
+    return rows
+
+
 def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
     """(angle_deg, p) from a two-column file: scattering angle (deg, 0..180, strictly increasing)
     and phase value (>= 0, any scale). Comma or whitespace separated; lines starting with '#' and a
@@ -132,21 +154,7 @@ def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
     if not path.is_file():
         raise TableError(f"phase table {path}: no such file")
     rows = []
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TableError(f"phase table {path}: cannot read it ({exc})") from None
-    for lineno, line in enumerate(text.splitlines(), 1):
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        fields = line.replace(",", " ").split()
-        try:
-            values = [float(x) for x in fields]
-        except ValueError:
-            if not rows:
-                continue  # a header line
-            raise TableError(f"phase table {path}, line {lineno}: not a number in {line!r}") from None
+    for lineno, values in numeric_rows(path, "phase table"):
         if len(values) != 2:
             raise TableError(f"phase table {path}, line {lineno}: expected 2 columns (angle_deg, "
                              f"value), got {len(values)}")

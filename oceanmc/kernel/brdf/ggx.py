@@ -57,19 +57,25 @@ def facet_reflectance(params, cos_h):
 
 
 @njit(error_model="numpy", cache=True)
-def specular(params, wix, wiy, wiz, wox, woy, woz):
-    """The microfacet part of f (1/sr)."""
-    if wiz <= 0.0 or woz <= 0.0:
-        return 0.0
+def half_vector(wix, wiy, wiz, wox, woy, woz):
+    """The unit bisector of wi and wo; (0, 0, 0) when they are opposite."""
     hx = wix + wox
     hy = wiy + woy
     hz = wiz + woz
     norm = math.sqrt(hx * hx + hy * hy + hz * hz)
     if norm <= 0.0:
+        return 0.0, 0.0, 0.0
+    return hx / norm, hy / norm, hz / norm
+
+
+@njit(error_model="numpy", cache=True)
+def specular(params, wix, wiy, wiz, wox, woy, woz):
+    """The microfacet part of f (1/sr)."""
+    if wiz <= 0.0 or woz <= 0.0:
         return 0.0
-    hx /= norm
-    hy /= norm
-    hz /= norm
+    hx, hy, hz = half_vector(wix, wiy, wiz, wox, woy, woz)
+    if hz <= 0.0:
+        return 0.0
     alpha = params[0]
     cos_h = wix * hx + wiy * hy + wiz * hz
     g2 = 1.0 / (1.0 + lam(alpha, wiz) + lam(alpha, woz))
@@ -96,15 +102,12 @@ def specular_pdf(params, wix, wiy, wiz, wox, woy, woz):
     """Density of the reflected visible-normal sample: G1(wi) D(h) / (4 cos t_i)."""
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
-    hx = wix + wox
-    hy = wiy + woy
-    hz = wiz + woz
-    norm = math.sqrt(hx * hx + hy * hy + hz * hz)
-    if norm <= 0.0:
+    hz = half_vector(wix, wiy, wiz, wox, woy, woz)[2]
+    if hz <= 0.0:
         return 0.0
     alpha = params[0]
     g1 = 1.0 / (1.0 + lam(alpha, wiz))
-    return g1 * distribution(alpha, hz / norm) / (4.0 * wiz)
+    return g1 * distribution(alpha, hz) / (4.0 * wiz)
 
 
 @njit(error_model="numpy", cache=True)
