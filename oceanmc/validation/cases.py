@@ -492,7 +492,7 @@ def case_fresnel(ctx: Ctx) -> None:
     down = list(np.arange(0.0, 90.0 + 1e-9, step))
     edges_cfg = down + [180.0 - d for d in reversed(down[:-1])]
     r = ctx.simulate(scene("sun at zenith, Lambertian bottom rho = 1 (water->air R)",
-                           ctx.pick(4_000_000, 200_000), sun=0.0, layers=[clear_layer()],
+                           ctx.pick(8_000_000, 400_000), sun=0.0, layers=[clear_layer()],
                            bottom={"model": "lambertian", "reflectance": 1.0},
                            theta_edges=edges_cfg, phi_bands=1))
     edges = edges_of(r)
@@ -505,7 +505,7 @@ def case_fresnel(ctx: Ctx) -> None:
     rwa = band_refs(edges, partial, lambda mu: float(ref.fresnel(n, 1.0, mu)),
                     points=[math.cos(math.radians(theta_c))])
     ctx.compare_jk("water->air R: L_down(0-)/L_up(0-) per band vs band-averaged R_wa", ratio, rwa,
-                   labels=band_labels(edges, partial), rel_cap=ctx.pick(0.01, 0.03))
+                   labels=band_labels(edges, partial), rel_cap=ctx.pick(0.015, 0.06))
     ctx.exact("water->air beyond the critical angle: L_down/L_up == 1 (TIR)",
               rad.value[beyond] / rad.value[n_t - 1 - beyond], 1.0, rtol=1e-12)
 
@@ -900,7 +900,9 @@ def case_white_furnace(ctx: Ctx) -> None:
         net = JK.of(r, "Ed") - JK.of(r, "Eu")
         ed = JK.of(r, "Ed")
         ctx.compare_jk("implicit: net flux Ed(z) - Eu(z) = 0 at every depth (relative to Ed)",
-                       net / ed, 0.0, labels=[f"z {d:g} m" for d in depths])
+                       net / ed, 0.0, labels=[f"z {d:g} m" for d in depths], ref_error=1e-10,
+                       note="ref_error 1e-10: floating-point floor (an estimator may make the "
+                       "net flux vanish batch by batch, up to rounding)")
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.5))
     r = res["implicit"]

@@ -121,9 +121,10 @@ class Ctx:
         standardised sum of z^2 (one-sided, <= 4) with the median relative standard error, which
         must not exceed rel_cap. With the members' leave-one-batch-out replicates (loo, batch
         axis first) and few enough members, the summary is Hotelling's T^2 with their estimated
-        covariance instead (members of one run, e.g. depths, are correlated). counts (optional): the expected number of photons per batch
-        that score each member; members below min_count are left out, since a batch mean of a
-        handful of photons is far from normal and its batch standard error is unreliable."""
+        covariance instead (members of one run, e.g. depths, are correlated). counts (optional):
+        the expected number of photons per batch that score each member; members below
+        min_count are left out, since a batch mean of a handful of photons is far from normal
+        and its batch standard error is unreliable."""
         value = np.atleast_1d(np.asarray(value, dtype=np.float64)).ravel()
         stderr = np.broadcast_to(np.asarray(stderr, dtype=np.float64), value.shape).ravel() \
             if np.ndim(stderr) else np.full(value.shape, float(stderr))

@@ -148,7 +148,7 @@ def band_averages(f, theta_edges_deg, mu_cut: float, points=None) -> np.ndarray:
     return out
 
 
-# --- BRDFs ------------------------------------------------------------------------------------------
+# --- BRDFs ----------------------------------------------------------------------------------------
 
 
 def minnaert_rho_dh(rho: float, k: float, mu_i) -> np.ndarray:
@@ -161,7 +161,7 @@ def minnaert_radiance(rho: float, k: float, mu_i: float, mu_r):
     return rho / math.pi * (mu_i * np.asarray(mu_r, dtype=np.float64)) ** k
 
 
-# --- Chandrasekhar ----------------------------------------------------------------------------------
+# --- Chandrasekhar --------------------------------------------------------------------------------
 
 
 @functools.lru_cache(maxsize=4096)

@@ -57,7 +57,8 @@ def source_revision() -> str:
 def write_results(outcomes, path: Path) -> None:
     records = [c.record() for o in outcomes for c in o.ctx.checks]
     tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(records, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    body = ",\n".join(json.dumps(r, allow_nan=False) for r in records)   # one record per line
+    tmp.write_text("[\n" + body + "\n]\n", encoding="utf-8")
     tmp.replace(path)
 
 
@@ -99,7 +100,8 @@ def write_report(outcomes, path: Path, *, quick: bool, wall_s: float, threads: i
         "",
         f"- mode: {'quick' if quick else 'full'}; generated {now}; total wall time "
         f"{wall_s:.0f} s on {threads or numba.get_num_threads()} threads",
-        f"- oceanmc {oceanmc.__version__} ({source_revision()}), numba {numba.__version__}, numpy {numpy.__version__}, "
+        f"- oceanmc {oceanmc.__version__} ({source_revision()}), numba {numba.__version__}, "
+        f"numpy {numpy.__version__}, "
         f"scipy {scipy.__version__}, Python {platform.python_version()} ({platform.machine()})",
         f"- photons simulated: {sum(r.photons for o in outcomes for r in o.ctx.runs):,} in "
         f"{sum(len(o.ctx.runs) for o in outcomes)} scenes",
@@ -135,9 +137,11 @@ def write_report(outcomes, path: Path, *, quick: bool, wall_s: float, threads: i
         f"- Tolerance: |z| <= {MIN_Z_TOL:g} for a single quantity. For a group of N compared "
         f"quantities (quads, bands) each member gets the Bonferroni bound at family-wise false "
         f"alarm {FAMILY_ALPHA:g} with Student's t (batches - 1 degrees of freedom), never below "
-        f"{MIN_Z_TOL:g}; and the group gets a summary check: the sum of z^2, standardised with "
-        "the mean and variance of t^2, must not exceed 4 (one-sided), which catches a small "
-        "bias spread over many bins.",
+        f"{MIN_Z_TOL:g}; and the group gets a summary check, which catches a small bias spread "
+        "over many bins: for groups of at most batches/2 members (often correlated, e.g. Ed at "
+        "several depths of one run) Hotelling's T^2 with the batch covariance, through its F "
+        "distribution, as a one-sided normal z; for larger groups (quads: disjoint bins) the "
+        "sum of z^2 standardised with the mean and variance of t^2. Either must not exceed 4.",
         "- Power: a check cannot pass by being noisy. Scalars carry a cap on the relative "
         "standard error (stderr/|reference|); groups a cap on its median over the group "
         "(recorded on the summary row). Quick mode uses about a tenth of the photons and "
@@ -205,7 +209,7 @@ def _case_section(o) -> list[str]:
             groups.setdefault(c.group, []).append(c)
     if groups:
         out += ["Groups (every member in results.json):", "",
-                "| group | N | worst \\|z\\| (bound) | worst member | sum z^2: z (<= 4) | "
+                "| group | N | worst \\|z\\| (bound) | worst member | group summary z (<= 4) | "
                 "max \\|rel. error\\| | median rel. stderr (cap) | pass |",
                 "|---|---|---|---|---|---|---|---|"]
         for name, cs in groups.items():
@@ -226,7 +230,8 @@ def _case_section(o) -> list[str]:
                    if summary and summary.rel_stderr_cap is not None
                    else (_pct(summary.rel_stderr) if summary else "-"))
             out.append(
-                f"| {name} | {len(members)} | {_fmt(abs(worst.z) if worst.z is not None else None, 3)}"
+                f"| {name} | {len(members)} | "
+                f"{_fmt(abs(worst.z) if worst.z is not None else None, 3)}"
                 f" ({_fmt(worst.tolerance, 3)}) | {label} | "
                 f"{_fmt(summary.z, 3) if summary else '-'} | "
                 f"{_pct(max(rels)) if rels else '-'} | {cap} | "

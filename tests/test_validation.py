@@ -1,0 +1,97 @@
+"""The validation suite: the quick run passes and writes a well-formed report, and deliberately
+broken physics (Schlick's approximation instead of the exact Fresnel formula) makes the Fresnel
+and optical-manhole cases fail."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import oceanmc.validation as v
+from oceanmc.validation import references as ref
+from oceanmc.validation.stats import JK, z_tolerance
+
+RECORD_KEYS = {"case", "quantity", "value", "stderr", "reference", "z", "tolerance", "pass"}
+
+
+def _check_records(records, cases):
+    assert isinstance(records, list) and records
+    for r in records:
+        assert RECORD_KEYS <= set(r), r
+        assert r["case"] in cases
+        assert isinstance(r["quantity"], str) and r["quantity"]
+        assert isinstance(r["pass"], bool)
+        for key in ("value", "stderr", "reference", "z", "tolerance"):
+            assert r[key] is None or (isinstance(r[key], (int, float)) and math.isfinite(r[key]))
+        if r["kind"] in ("z", "chi2") and r["pass"]:
+            assert r["z"] is not None and r["tolerance"] >= 4.0
+            if r["kind"] == "z":
+                assert abs(r["z"]) <= r["tolerance"]
+
+
+def test_quick_validation_passes(tmp_path, capsys):
+    status = v.main(tmp_path, quick=True)
+    out = capsys.readouterr().out
+    records = json.loads((tmp_path / "results.json").read_text())
+    names = {c.name for c in v.CASES}
+    _check_records(records, names)
+    failing = [r for r in records if not r["pass"]]
+    assert status == 0, failing[:10]
+    assert {r["case"] for r in records} == names
+    for name in names:   # one stdout line per case
+        assert any(line.startswith(name) and "PASS" in line for line in out.splitlines())
+    report = (tmp_path / "report.md").read_text()
+    assert "Overall: PASS" in report
+    figures = sorted((tmp_path / "figures").glob("*.png"))
+    assert len(figures) >= len(names)
+    for fig in figures:
+        assert f"figures/{fig.name}" in report
+        assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+SCHLICK = {"surface": {"fresnel": "schlick"}}
+
+
+@pytest.mark.parametrize("case", ["fresnel", "optical_manhole"])
+def test_schlick_fresnel_makes_the_surface_cases_fail(case):
+    outcome = v.run_case(case, quick=True, override=SCHLICK)
+    assert outcome.error is None, outcome.error
+    failing = [c for c in outcome.ctx.checks if not c.passed]
+    # the Monte Carlo checks fail, not the references' own checks
+    assert any(not c.quantity.startswith("reference:") for c in failing)
+    assert all(not c.quantity.startswith("reference:") for c in failing)
+    assert not outcome.passed
+
+
+def test_override_through_the_environment(tmp_path, monkeypatch):
+    monkeypatch.setenv(v.ENV_OVERRIDE, json.dumps(SCHLICK))
+    monkeypatch.setenv(v.ENV_CASES, "fresnel")
+    assert v.main(tmp_path, quick=True) == 1
+    records = json.loads((tmp_path / "results.json").read_text())
+    _check_records(records, {"fresnel"})
+    assert any(not r["pass"] for r in records)
+    assert "override" in (tmp_path / "report.md").read_text()
+
+
+def test_references_reproduce_the_design_numbers():
+    n = 1.34
+    assert ref.fresnel(1.0, n, 1.0) == pytest.approx(0.02111, abs=5e-6)
+    assert ref.sky_reflectance(n, "uniform") == pytest.approx(0.0675, abs=5e-5)
+    assert ref.sky_reflectance(n, "cardioidal") == pytest.approx(0.0522, abs=5e-5)
+    assert ref.uniform_upwelling_reflectance(n) == pytest.approx(0.4807, abs=5e-5)
+    assert ref.critical_angle_deg(n) == pytest.approx(48.27, abs=5e-3)
+    assert ref.chandrasekhar_albedo(0.8, 0.5) == pytest.approx(0.36797, abs=5e-6)
+    assert ref.chandrasekhar_radiance(0.8, 0.5, 1.0) == pytest.approx(0.09586, abs=5e-6)
+
+
+def test_jackknife_matches_the_batch_standard_error():
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(40, 3))
+    est = JK.from_batches(x)
+    assert np.allclose(est.value, x.mean(axis=0))
+    assert np.allclose(est.stderr, x.std(axis=0, ddof=1) / math.sqrt(40))
+    ratio = est[0] / est[1]
+    assert ratio.value == pytest.approx(x[:, 0].mean() / x[:, 1].mean())
+    assert z_tolerance(1, 64) == 4.0 and z_tolerance(400, 64) > 4.0
