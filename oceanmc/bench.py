@@ -206,8 +206,9 @@ def error_vs_time(scene: dict, counts: list[int], reference_photons: int, thread
     else:
         reference_se = {label: 0.0 for label in reference}
     rows = []
-    for photons in counts:
-        result = simulate(with_photons(config, photons), threads=threads)
+    for i, photons in enumerate(counts):
+        # another seed per count, so the rows of a scene are independent samples
+        result = simulate(with_photons(config, photons, seed=config.seed + i), threads=threads)
         wall = result.attrs["wall_time_s"]
         for q in scene["quantities"]:
             value, se = _value(result, q)
