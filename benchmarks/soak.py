@@ -28,9 +28,11 @@ def main() -> None:
     parser.add_argument("-o", "--output", default="benchmarks/soak.json")
     args = parser.parse_args()
     scene = Path(__file__).resolve().parents[1] / "configs" / "bare_walk.yaml"
-    # more photons than the run can trace: it ends at the deadline, between batches of 500k
-    config = oceanmc.load_config(scene).model_copy(update={"photons": 8192 * 500_000,
-                                                           "batches": 8192})
+    # more photons than the run can trace: it ends at the deadline, between groups of batches
+    # (256 batches of 50M photons: the tallies take 256 x the per-batch size, whatever the
+    # photon count, so memory must stay flat)
+    config = oceanmc.load_config(scene).model_copy(update={"photons": 256 * 50_000_000,
+                                                           "batches": 256})
     short = oceanmc.simulate(config.model_copy(update={"photons": 2_000_000, "batches": 64,
                                                        "seed": 99}), threads=args.threads)
     samples = []
