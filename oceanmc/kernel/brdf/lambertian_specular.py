@@ -13,6 +13,7 @@ import math
 from numba import njit
 
 from ..geometry import from_angles
+from . import lambertian
 
 
 @njit(error_model="numpy", cache=True)
@@ -32,10 +33,9 @@ def sample(params, wix, wiy, wiz, u1, u2):
 
 @njit(error_model="numpy", cache=True)
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
-    """The diffuse part only (the mirror is a delta function; see the module note)."""
-    if wiz <= 0.0 or woz <= 0.0:
-        return 0.0
-    return params[0] / math.pi
+    """The diffuse part only (the mirror is a delta function; see the module note): the
+    Lambertian f of reflectance params[0]."""
+    return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
 
 
 @njit(error_model="numpy", cache=True)
