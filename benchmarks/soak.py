@@ -55,11 +55,11 @@ def main() -> None:
                                                      else list(v), (a, b, ea, eb))))):
             rows.append({"quantity": name, "index": i, "long": float(x), "long_se": float(sx),
                          "short": float(y), "short_se": float(sy),
-                         "z": float((x - y) / math.hypot(sx, sy))})
+                         "z": float((x - y) / math.hypot(sx, sy)) if sx or sy else None})
     report = {"minutes": args.minutes, "photons": int(long.attrs["photons"]),
               "photons_per_s": long.attrs["photons_per_s"], "peak_rss_mb": peak_rss_mb(),
               "samples": samples, "comparison_with_short_run": rows,
-              "max_abs_z": max(abs(r["z"]) for r in rows)}
+              "max_abs_z": max(abs(r["z"]) for r in rows if r["z"] is not None)}
     Path(args.output).write_text(json.dumps(report, indent=1))
     print(json.dumps({k: v for k, v in report.items() if k not in ("samples",
                                                                     "comparison_with_short_run")}))
