@@ -8,6 +8,9 @@ Everything is measured in one run on this machine, so ratios compare like with l
 - error against time: each scene at increasing photon counts; the error of headline quantities
   against a reference (analytic where there is one, else a long run in the same benchmark);
   the figure of merit FOM = 1 / (rel_err^2 time) per quantity and estimator;
+- sky sampling: a sky map with a small bright spot, importance-sampled against cosine-sampled
+  (sky_maps.py), error against time for both against one long importance-sampled run, and the
+  FOM ratio importance / cosine per quantity;
 - start-up: the first run with an empty compilation cache, and a run with the cache filled.
 Writes DIR/bench.md, DIR/bench.json and DIR/error_vs_time.png.
 """
@@ -93,6 +96,53 @@ def scenes(configs_dir: Path) -> list[dict]:
          "quantities": [Quantity("Ed(0-)", "Ed", (0,)),
                         Quantity("L cap down (0-)", "radiance", (0, 0, 0))]},
     ]
+
+
+SPOT_ZENITH_DEG = 40.0       # the bright spot's centre, seen at phi_view = 180 deg
+SPOT_RADIUS_DEG = 2.0
+SPOT_CONTRAST = 1000.0       # spot radiance over the background's
+IMPORTANCE, COSINE = "(importance sampling)", "(cosine sampling)"
+SKY_SPOT = "sky map with a small bright spot"
+
+
+def sky_spot_map(path: Path) -> Path:
+    """Writes a 1 x 1 deg sky map (.npy): radiance 1, and SPOT_CONTRAST inside the cells whose
+    centres lie within SPOT_RADIUS_DEG of the spot's centre (20 cells, ~0.004 sr, half of the
+    sky's irradiance)."""
+    theta = np.radians(np.arange(90) + 0.5)[:, None]
+    phi = np.radians(np.arange(360) + 0.5)[None, :]
+    centre = math.radians(SPOT_ZENITH_DEG)
+    cos_from_centre = (np.cos(theta) * math.cos(centre)
+                       + np.sin(theta) * math.sin(centre) * np.cos(phi - math.pi))
+    inside = cos_from_centre >= math.cos(math.radians(SPOT_RADIUS_DEG))
+    np.save(path, np.where(inside, SPOT_CONTRAST, 1.0))
+    return path
+
+
+def sky_spot_scenes(map_path: Path) -> list[dict]:
+    """The spot map over clear, weakly scattering deep water, all light from the sky, sampled
+    by importance and cosine-weighted: the same expectations, so one reference serves both."""
+    def config(sampling):
+        return load_config({
+            "name": f"{SKY_SPOT}, {sampling} sampling", "seed": 1,
+            "illumination": {"Ed0": 1.0, "diffuse_fraction": 1.0,
+                             "sky": {"map": str(map_path), "sampling": sampling}},
+            "water": {"layers": [{"thickness_m": math.inf, "a": 0.1, "b": 0.2,
+                                  "phase": {"model": "henyey_greenstein", "g": 0.9}}]},
+            "bottom": {"model": "none"}, "tallies": {"depths_m": [0.0, 5.0]}})
+    importance = config("importance")
+    # the spot's light travels at phi = 0 (phi_view + 180 deg), refracted by Snell's law
+    n = importance.surface.n_water
+    refracted = math.degrees(math.asin(math.sin(math.radians(SPOT_ZENITH_DEG)) / n))
+    band = int(np.searchsorted(importance.tallies.theta_edges, refracted, side="right")) - 1
+    quantities = [Quantity("Ed(0-)", "Ed", (0,)), Quantity("Ed(5 m)", "Ed", (1,)),
+                  Quantity("Eou(0-)", "Eou", (0,)), Quantity("Lu(0-) (local)", "Lu", (0,)),
+                  Quantity(f"L of the spot's quad (0-, {refracted:.1f} deg)", "radiance",
+                           (0, band, 0))]
+    return [{"name": f"{SKY_SPOT} {IMPORTANCE}", "config": importance, "reference": None,
+             "quantities": quantities},
+            {"name": f"{SKY_SPOT} {COSINE}", "config": config("cosine"), "reference": None,
+             "quantities": quantities}]
 
 
 def with_photons(config, photons: int, **changes):
@@ -186,25 +236,37 @@ def startup_times(cold: bool = True) -> dict:
     return out
 
 
-def error_vs_time(scene: dict, counts: list[int], reference_photons: int, threads: int,
-                  progress: Callable[[str], None]) -> dict:
+def long_run_reference(scene: dict, photons: int, threads: int,
+                       progress: Callable[[str], None]) -> tuple[dict, dict, str]:
+    """(values, standard errors, description) of the scene's quantities from one long run with
+    another seed."""
     config = scene["config"]
-    reference = scene["reference"]
-    ref_source = "analytic"
-    if reference is None:
-        progress(f"  reference run, {reference_photons:,} photons")
-        long = simulate(with_photons(config, reference_photons, seed=config.seed + 1000),
-                        threads=threads)
-        values = {q.label: _value(long, q) for q in scene["quantities"]}
-        # a crossing estimate is compared with the long run's local estimate of the same
-        # quantity (same expectation, smaller error)
-        best = {label: values.get(label.replace("(crossing)", "(local)"), values[label])
-                for label in values}
-        reference = {label: v[0] for label, v in best.items()}
-        reference_se = {label: v[1] for label, v in best.items()}
-        ref_source = f"long run ({reference_photons:,} photons, another seed)"
+    progress(f"  reference run, {photons:,} photons")
+    long = simulate(with_photons(config, photons, seed=config.seed + 1000), threads=threads)
+    values = {q.label: _value(long, q) for q in scene["quantities"]}
+    # a crossing estimate is compared with the long run's local estimate of the same
+    # quantity (same expectation, smaller error)
+    best = {label: values.get(label.replace("(crossing)", "(local)"), values[label])
+            for label in values}
+    return ({label: v[0] for label, v in best.items()},
+            {label: v[1] for label, v in best.items()},
+            f"long run ({photons:,} photons, another seed)")
+
+
+def error_vs_time(scene: dict, counts: list[int], reference_photons: int, threads: int,
+                  progress: Callable[[str], None], reference: tuple | None = None) -> dict:
+    """The scene at each photon count against its analytic reference, a long run of its own,
+    or `reference` (a long_run_reference shared by scenes with the same expectations)."""
+    config = scene["config"]
+    if reference is not None:
+        reference, reference_se, ref_source = reference
+    elif scene["reference"] is None:
+        reference, reference_se, ref_source = long_run_reference(scene, reference_photons,
+                                                                 threads, progress)
     else:
+        reference = scene["reference"]
         reference_se = {label: 0.0 for label in reference}
+        ref_source = "analytic"
     rows = []
     for i, photons in enumerate(counts):
         # another seed per count, so the rows of a scene are independent samples
@@ -244,8 +306,12 @@ def plot(curves: list[dict], path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(curves), figsize=(4.2 * len(curves), 4), squeeze=False)
-    for ax, curve in zip(axes[0], curves):
+    ncols = min(3, len(curves))
+    nrows = -(-len(curves) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 4 * nrows), squeeze=False)
+    for ax in axes.flat[len(curves):]:
+        ax.set_visible(False)
+    for ax, curve in zip(axes.flat, curves):
         labels = sorted({r["quantity"] for r in curve["rows"]})
         for label in labels:
             rows = [r for r in curve["rows"] if r["quantity"] == label]
@@ -256,7 +322,7 @@ def plot(curves: list[dict], path: Path) -> None:
             line, = ax.loglog(t, rel, "o-", label=label)
             ax.loglog(t, err, "x", color=line.get_color(), alpha=0.6)
             ax.loglog(t, rel[0] * np.sqrt(t[0] / t), ":", color=line.get_color(), alpha=0.5)
-        ax.set_title(curve["scene"])
+        ax.set_title(curve["scene"], fontsize=9)
         ax.set_xlabel("wall time (s)")
         ax.set_ylabel("relative error (o: std err, x: |error| vs ref)")
         ax.legend(fontsize=6)
@@ -316,6 +382,23 @@ def write_report(out_dir: Path, data: dict) -> None:
         lines += ["", "Local over crossing estimator, same quantity and scene:", ""]
         for key, value in ratios.items():
             lines.append(f"- {key}: {value:.1f}x")
+    spot = data.get("sky_sampling")
+    if spot:
+        lines += ["", f"## Sky sampling: {SKY_SPOT}", "",
+                  f"A 1 x 1 deg sky map, radiance 1 with a disc of radius {SPOT_RADIUS_DEG:g} deg "
+                  f"at zenith {SPOT_ZENITH_DEG:g} deg {SPOT_CONTRAST:g} times brighter (half of "
+                  "the sky's irradiance), all of Ed0 from the sky, over deep water (a = 0.1, "
+                  "b = 0.2 1/m, HG g = 0.9). The same scene with `sampling: importance` "
+                  "(directions in proportion to L cos) and `sampling: cosine` (directions "
+                  "cosine-weighted, weights L pi / E), both against one long importance-sampled "
+                  "run; the rows are in the tables above. With cosine sampling the spot is hit "
+                  "by ~1 photon in 1000 carrying ~500 times the mean weight, so its standard "
+                  "errors at the smaller counts are themselves uncertain (see z).", "",
+                  "| quantity | FOM importance | FOM cosine | ratio importance / cosine |",
+                  "|---|---|---|---|"]
+        for row in spot:
+            lines.append(f"| {row['quantity']} | {row['fom_importance']:.3g} | "
+                         f"{row['fom_cosine']:.3g} | {row['ratio']:.3g} |")
     (out_dir / "bench.md").write_text("\n".join(lines) + "\n")
 
 
@@ -327,6 +410,19 @@ def fom_ratios(foms: list[dict]) -> dict[str, float]:
             other = table.get((scene, label.replace("(local)", "(crossing)")))
             if other:
                 out[f"{scene}, {label.replace(' (local)', '')}"] = value / other
+    return out
+
+
+def sampling_ratios(foms: list[dict]) -> list[dict]:
+    """Median FOM per quantity of the importance- and the cosine-sampled sky-spot scenes and
+    their ratio."""
+    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    out = []
+    for (scene, label), fom in table.items():
+        if scene == f"{SKY_SPOT} {IMPORTANCE}":
+            cosine = table[(f"{SKY_SPOT} {COSINE}", label)]
+            out.append({"quantity": label, "fom_importance": fom, "fom_cosine": cosine,
+                        "ratio": fom / cosine})
     return out
 
 
@@ -358,8 +454,20 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
     for scene in scenes(configs_dir):
         say(f"error vs time: {scene['name']} ...")
         data["error_vs_time"].append(error_vs_time(scene, counts, reference_photons, 2, say))
+    spot_counts = [10_000, 20_000] if quick else [100_000, 400_000, 1_600_000]
+    spot_reference_photons = 40_000 if quick else 8_000_000
+    with tempfile.TemporaryDirectory() as tmp:
+        pair = sky_spot_scenes(sky_spot_map(Path(tmp) / "sky_spot.npy"))
+        say(f"error vs time: {SKY_SPOT} ...")
+        values, stderrs, source = long_run_reference(pair[0], spot_reference_photons, 2, say)
+        for scene in pair:
+            say(f"  {scene['name']}")
+            data["error_vs_time"].append(error_vs_time(
+                scene, spot_counts, spot_reference_photons, 2, say,
+                reference=(values, stderrs, f"{source}, importance sampling")))
     data["fom"] = fom_summary(data["error_vs_time"])
     data["fom_ratios"] = fom_ratios(data["fom"])
+    data["sky_sampling"] = sampling_ratios(data["fom"])
     write_report(out_dir, data)
     say(f"wrote {out_dir / 'bench.md'}")
     return 0

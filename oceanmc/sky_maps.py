@@ -33,6 +33,15 @@ and phi uniformly within the cell. For a map (piecewise constant) this density i
 proportional to L cos, so every sky photon carries the same weight. Harrison-Coombes is drawn
 from its cell averages on a 1 x 2 deg grid and weighted by L(direction) / L(cell) (the exact
 density is used in the weight), so it is reproduced exactly, not only to the grid.
+
+A map with `sampling: cosine` is drawn cosine-weighted over the whole hemisphere instead
+(sin^2(theta) and phi uniform: density cos(theta) / pi, whatever L), and each photon is weighted
+by L(cell) pi / E, E = integral of L cos dOmega over the map = sum over cells of
+L (sin^2 theta_hi - sin^2 theta_lo) dphi / 2; its expectation is therefore 1, and every tally
+has the same expectation as under importance sampling. The cell of a drawn direction is found by
+bisection on the same sin^2(theta) and phi_view edges the direction was drawn in, so the weight
+is exactly the radiance of the cell the photon comes from. It exists to show what importance
+sampling gains (oceanmc bench: a small bright spot), or to check it.
 """
 from __future__ import annotations
 
@@ -191,9 +200,25 @@ def sky_fields(ill: cfg.Illumination) -> dict:
         model = models.SKY_HARRISON_COOMBES
     else:
         theta, phi, L = read_sky_map(sky.map, sky.dataset)
-        model = models.SKY_MAP
-    return dict(sampling_tables(theta, phi, L), sky_model=model,
-                sky_params=sky_parameters(ill.sun_zenith_deg))
+        model = models.SKY_MAP if sky.sampling == "importance" else models.SKY_MAP_COSINE
+    tables = sampling_tables(theta, phi, L)
+    if model == models.SKY_MAP_COSINE:
+        # the cosine sampler uses only the edges; the cells hold its photon weights
+        tables["sky_cell_L"] = cosine_weights(tables["sky_s_edges"], tables["sky_phi_edges"], L)
+    return dict(tables, sky_model=model, sky_params=sky_parameters(ill.sun_zenith_deg))
+
+
+def cosine_weights(s_edges: np.ndarray, phi_edges: np.ndarray, L: np.ndarray) -> np.ndarray:
+    """The weight L pi / E of a photon from each cell under cosine-weighted sampling (density
+    cos / pi), E = integral of L cos dOmega over the map, on the sampler's own edges (sin^2 theta,
+    phi in rad): the cells' probabilities ds dphi / (2 pi) times these weights sum to 1."""
+    return np.ascontiguousarray(L * (math.pi / cell_cos_mass(s_edges, phi_edges, L).sum()))
+
+
+def cell_cos_mass(s_edges: np.ndarray, phi_edges: np.ndarray, L: np.ndarray) -> np.ndarray:
+    """L x integral of cos dOmega over each cell = L (sin^2 theta_hi - sin^2 theta_lo) dphi / 2
+    (s_edges: sin^2 theta; phi_edges in rad)."""
+    return L * np.diff(s_edges)[:, None] * np.diff(phi_edges)[None, :] * 0.5
 
 
 def sky_parameters(sun_zenith_deg: float) -> np.ndarray:
@@ -209,7 +234,7 @@ def sampling_tables(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray) -
     s_edges[0] = 0.0
     s_edges[-1] = 1.0
     phi = np.radians(phi_deg)
-    mass = L * np.diff(s_edges)[:, None] * np.diff(phi)[None, :] * 0.5
+    mass = cell_cos_mass(s_edges, phi, L)
     rows = mass.sum(axis=1)
     row_cdf = np.cumsum(rows) / rows.sum()
     last = int(np.nonzero(rows > 0.0)[0][-1])

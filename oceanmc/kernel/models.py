@@ -32,6 +32,7 @@ SKY_UNIFORM = 0
 SKY_CARDIOIDAL = 1       # L ~ 1 + 2 cos(zenith angle): the CIE standard overcast sky
 SKY_MAP = 2              # a tabulated radiance map, piecewise constant on its cells (sky_maps.py)
 SKY_HARRISON_COOMBES = 3  # Harrison & Coombes (1988) clear sky; a fine map as the proposal
+SKY_MAP_COSINE = 4       # a map sampled cosine-weighted, each photon weighted by its cell's L
 
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0

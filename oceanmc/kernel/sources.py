@@ -6,8 +6,9 @@ import math
 import numpy as np
 from numba import njit
 
+from .brdf.general import first_above
 from .geometry import from_angles
-from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP
+from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP, SKY_MAP_COSINE
 
 
 @njit(error_model="numpy", cache=True)
@@ -21,20 +22,6 @@ def sky_cosine(sky_model):
             if 3.0 * np.random.random() < 1.0 + 2.0 * mu:
                 return mu
     return math.sqrt(np.random.random())
-
-
-@njit(error_model="numpy", cache=True)
-def first_above_row(cdf, u):
-    """Smallest k with u < cdf[k] (cdf ends at 1)."""
-    lo = -1
-    hi = cdf.shape[0] - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if u < cdf[mid]:
-            hi = mid
-        else:
-            lo = mid
-    return hi
 
 
 @njit(error_model="numpy", cache=True)
@@ -69,15 +56,25 @@ def sky_direction(sc):
     the cell (density exactly proportional to the cell's L cos); the map gives the view
     direction, the photon travels the opposite way (phi + 180 deg). Harrison-Coombes is weighted
     by L(direction) / L(cell), so its exact radiance is reproduced; maps and the analytic shapes
-    have factor 1."""
+    have factor 1. A cosine-sampled map draws sin^2(theta) and phi_view uniformly (density
+    cos / pi over the hemisphere), finds the cell by bisection on the same edges and takes the
+    cell's L pi / E as the factor (sky_cell_L holds it; sky_maps.cosine_weights)."""
     model = sc.sky_model
-    if model == SKY_MAP or model == SKY_HARRISON_COOMBES:
-        row = first_above_row(sc.sky_row_cdf, np.random.random())
-        col = first_above_cell(sc.sky_cell_cdf, row, np.random.random())
-        s0 = sc.sky_s_edges[row]
-        s = s0 + np.random.random() * (sc.sky_s_edges[row + 1] - s0)
-        p0 = sc.sky_phi_edges[col]
-        phi_view = p0 + np.random.random() * (sc.sky_phi_edges[col + 1] - p0)
+    if model == SKY_MAP or model == SKY_HARRISON_COOMBES or model == SKY_MAP_COSINE:
+        if model == SKY_MAP_COSINE:
+            s = np.random.random()
+            phi_view = sc.sky_phi_edges[0] + 2.0 * math.pi * np.random.random()
+            # the cell holding (s, phi_view): one before the first edge above it (the last cell
+            # if rounding puts phi_view on the final edge)
+            row = first_above(sc.sky_s_edges, 0, sc.sky_s_edges.shape[0], s) - 1
+            col = first_above(sc.sky_phi_edges, 0, sc.sky_phi_edges.shape[0], phi_view) - 1
+        else:
+            row = first_above(sc.sky_row_cdf, 0, sc.sky_row_cdf.shape[0], np.random.random())
+            col = first_above_cell(sc.sky_cell_cdf, row, np.random.random())
+            s0 = sc.sky_s_edges[row]
+            s = s0 + np.random.random() * (sc.sky_s_edges[row + 1] - s0)
+            p0 = sc.sky_phi_edges[col]
+            phi_view = p0 + np.random.random() * (sc.sky_phi_edges[col + 1] - p0)
         sin_t = math.sqrt(min(1.0, max(0.0, s)))
         uz = math.sqrt(max(0.0, 1.0 - s))
         ux = -sin_t * math.cos(phi_view)
@@ -85,6 +82,8 @@ def sky_direction(sc):
         if model == SKY_HARRISON_COOMBES:
             return ux, uy, uz, harrison_coombes(sc.sky_params, ux, uy, uz) \
                 / sc.sky_cell_L[row, col]
+        if model == SKY_MAP_COSINE:
+            return ux, uy, uz, sc.sky_cell_L[row, col]
         return ux, uy, uz, 1.0
     mu = sky_cosine(model)
     ux, uy, uz = from_angles(mu, 2.0 * math.pi * np.random.random())
