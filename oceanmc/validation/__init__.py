@@ -9,8 +9,8 @@ out_dir/report.md, out_dir/figures/*.png and out_dir/results.json (a list of rec
 quantity, value, stderr, reference, z, tolerance, pass, and kind, group, ref_error, rel_error,
 rel_stderr, rel_stderr_cap, note). The command line `oceanmc validate [-o DIR] [--quick]` calls it.
 
-Cases (see cases.py and the report): brdf_bottom, optical_manhole, fresnel, beer_lambert,
-chandrasekhar, disort, white_furnace, reciprocity.
+Cases (see cases.py, brdf_models.py and the report): brdf_bottom, brdf_models,
+optical_manhole, fresnel, beer_lambert, chandrasekhar, disort, white_furnace, reciprocity.
 
 Running with deliberately changed physics (to show that a check can fail):
 

@@ -998,9 +998,14 @@ def case_reciprocity(ctx: Ctx) -> None:
              "Runs with the same batch count are paired batch by batch for the jackknife.")
 
 
+from .brdf_models import case_brdf_models  # noqa: E402  (it uses the helpers above)
+
 CASES = [
     Case("brdf_bottom", "Lambertian and Minnaert bottoms without water", case_brdf,
          "reflected flux vs rho_dh(theta_i), radiance vs (rho/pi)(cos t_i cos t_r)^k"),
+    Case("brdf_models", "GGX, Hapke, Lambertian + mirror and table bottoms; the general sampler",
+         case_brdf_models, "Eu/Ed vs rho_dh(theta_i) and quad radiance vs quad averages of f, "
+         "both integrated numerically from the models' formulas"),
     Case("optical_manhole", "Snell's window, the n^2 law and total internal reflection",
          case_manhole, "radiance below a flat surface under sky and sun; TIR; sky reflectances"),
     Case("fresnel", "Fresnel reflectance from both sides of the surface", case_fresnel,
