@@ -227,6 +227,8 @@ def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
         cap_fine_end=fine_end, cap_fine_step=fine_step, cap_coarse_step=coarse_step,
         cap_fine_nodes=int(fine_nodes),
         cap_mu_w=mu_w, cap_omega_w=2.0 * math.pi * (1.0 - math.cos(beta)),
+        # transmission along mu_w from each level to the one above it (the first: unused)
+        cap_level_decay=np.exp(-np.diff(sc.level_tau, prepend=sc.level_tau[:1]) / mu_w),
         cap_cos_water=math.cos(beta), cap_mu_a=mu_a,
         cap_omega_a=2.0 * math.pi * (1.0 - math.cos(beta)), cap_cos_air=math.cos(beta),
         cap_h=float(h[1]), cap_dh=float((h[2] - h[0]) / (2.0 * step)))
@@ -298,8 +300,10 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         surface_flat=config.surface.model == "flat", n_water=float(config.n_water),
         fresnel_schlick=config.surface.fresnel == "schlick",
         plane_z=plane_z, plane_tally=plane_tally, segment_layer=segment_layer,
-        layer_a=np.array([layer.a for layer in layers], dtype=np.float64),
-        layer_b=np.array([layer.b for layer in layers], dtype=np.float64),
+        layer_c=layer_c,
+        layer_inv_c=np.divide(1.0, layer_c, out=np.zeros_like(layer_c), where=layer_c > 0.0),
+        layer_albedo=np.array([layer.b / (layer.a + layer.b) if layer.b > 0.0 else 0.0
+                               for layer in layers], dtype=np.float64),
         layer_comp_start=np.array(comp_start, dtype=np.int64),
         layer_comp_count=np.array(comp_count, dtype=np.int64),
         comp_cumweight=np.array(cumweight, dtype=np.float64),

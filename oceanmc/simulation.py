@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from . import __version__, scene
 from .config import SceneConfig, config_to_yaml, load_config
-from .kernel.driver import run_batches
+from .kernel.driver import photon_loop
 from .results import Result, budget_terms, from_tallies
 
 
@@ -49,10 +49,10 @@ def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str
     }
 
 
-def _run(sc, n_per_batch: int, seeds: np.ndarray, raw: dict, lo: int, hi: int) -> None:
-    run_batches(sc, n_per_batch, seeds[lo:hi], raw["flux"][lo:hi], raw["radiance"][lo:hi],
-                raw["local"][lo:hi], raw["cap"][lo:hi], raw["budget"][lo:hi],
-                raw["events"][lo:hi])
+def _batches(raw: dict, lo: int, hi: int) -> tuple:
+    """The tally arrays of batches lo .. hi - 1, in the photon loop's argument order."""
+    return tuple(raw[name][lo:hi] for name in ("flux", "radiance", "local", "cap", "budget",
+                                                "events"))
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -84,8 +84,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     raw = allocate(sc, n_batches, len(depths), grid, n_layers)
 
     t0 = time.perf_counter()
-    scratch = allocate(sc, 1, len(depths), grid, n_layers)
-    _run(sc, 1, seeds[:1], scratch, 0, 1)  # compiles (or loads the cache) outside the timing
+    # compiles this scene's loop (or loads it from the cache) outside the timing
+    loop = photon_loop(sc, n_per_batch, seeds, *_batches(raw, 0, 1))
     startup = time.perf_counter() - t0
 
     def result_of(done: int, wall: float) -> Result:
@@ -119,7 +119,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
               disable=not progress, desc=config.name[:40], leave=False) as bar:
         while done < n_batches:
             hi = min(n_batches, done + group)
-            _run(sc, n_per_batch, seeds, raw, done, hi)
+            loop(n_per_batch, seeds[done:hi], *_batches(raw, done, hi))
             bar.update((hi - done) * n_per_batch)
             done = hi
             if should_stop is not None and should_stop():

@@ -1,13 +1,52 @@
 """Batches in parallel: prange over the batches of one call; each batch writes only its own slice
 of the tally arrays and seeds its own random stream, so results do not depend on the thread count
-or on how batches are grouped into calls."""
-from numba import njit, prange
+or on how batches are grouped into calls.
 
+The photon loop is specialised by the features a scene uses (features_of): the bit mask is a
+compile-time constant (a literal type), so each combination compiles its own loop, once, and the
+disk cache keeps it. photon_loop() resolves the specialisation once per run: a plain call with a
+literal would go through Numba's slow dispatch path (a failed typing, then a recompilation
+attempt from the cache, 14 ms) on every call."""
+from numba import literally, njit, prange, typeof
+from numba.core import types
+
+from .models import (BOTTOM_BLACK, BOTTOM_NONE, FEATURE_BOTTOM, FEATURE_ESTIMATES,
+                     FEATURE_RADIANCE, FEATURE_SKY)
 from .transport import trace_batch
 
 
+def features_of(sc) -> int:
+    """The FEATURE_* bits of the scene arrays: what the photon loop must contain for them."""
+    features = 0
+    if sc.diffuse_fraction > 0.0:
+        features |= FEATURE_SKY
+    if sc.bottom_model not in (BOTTOM_NONE, BOTTOM_BLACK):
+        features |= FEATURE_BOTTOM
+    if sc.tally_radiance:
+        features |= FEATURE_RADIANCE
+    if sc.local_estimates or sc.cap_estimates:
+        features |= FEATURE_ESTIMATES
+    return features
+
+
 @njit(parallel=True, error_model="numpy", cache=True)
-def run_batches(sc, n_photons, seeds, flux, radiance, local, cap, budget, events):
+def run_batches(sc, features, n_photons, seeds, flux, radiance, local, cap, budget, events):
+    features = literally(features)
     for i in prange(seeds.shape[0]):
-        events[i] = trace_batch(sc, n_photons, seeds[i], flux[i], radiance[i], local[i],
+        events[i] = trace_batch(sc, features, n_photons, seeds[i], flux[i], radiance[i], local[i],
                                 cap[i], budget[i])
+
+
+def photon_loop(sc, n_photons, seeds, flux, radiance, local, cap, budget, events):
+    """run_batches compiled (or loaded from the cache) for this scene's features and these
+    argument types, as a function of (n_photons, seeds, flux, radiance, local, cap, budget,
+    events); later calls must pass arrays of the same types (slices of the same tallies)."""
+    features = features_of(sc)
+    signature = (typeof(sc), types.literal(features)) + tuple(
+        typeof(a) for a in (n_photons, seeds, flux, radiance, local, cap, budget, events))
+    compiled = run_batches.overloads.get(signature)
+    if compiled is None:
+        run_batches.compile(signature)
+        compiled = run_batches.overloads[signature]
+    entry = compiled.entry_point
+    return lambda *tallies: entry(sc, features, *tallies)

@@ -3,6 +3,8 @@ import math
 
 from numba import njit
 
+from .geometry import renormalised
+
 
 @njit(error_model="numpy", cache=True)
 def fresnel(n1, n2, cos_i):
@@ -51,5 +53,4 @@ def refract(ux, uy, uz, ratio, cos_t):
     nx = ux * ratio
     ny = uy * ratio
     nz = cos_t if uz > 0.0 else -cos_t
-    norm = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-    return nx * norm, ny * norm, nz * norm
+    return renormalised(nx, ny, nz)

@@ -39,8 +39,7 @@ def add_to_levels(sc, local, z, tau_here, k, base, mu):
 
 @njit(error_model="numpy", cache=True, inline="always")
 def score_collision(sc, local, seg, layer, z, w_scattered, ux, uy, uz):
-    c = sc.layer_a[layer] + sc.layer_b[layer]
-    tau_here = sc.plane_tau[seg] + c * (z - sc.plane_z[seg])
+    tau_here = sc.plane_tau[seg] + sc.layer_c[layer] * (z - sc.plane_z[seg])
     for k in range(sc.le_dirs.shape[0]):
         dx = sc.le_dirs[k, 0]
         dy = sc.le_dirs[k, 1]
@@ -86,17 +85,23 @@ def cap_lookup(sc, table, cos_alpha):
 @njit(error_model="numpy", cache=True, inline="always")
 def cap_collision(sc, cap, seg, layer, z, w_scattered, uz):
     """Polar-cap average of the nadir-viewing radiance sent by one collision to every level
-    above it and to 0+ (see cap_tables.py for the expansion and its accuracy)."""
+    above it and to 0+ (see cap_tables.py for the expansion and its accuracy). The levels are
+    sorted by depth: the transmission to the deepest one above is one exp, and each level up
+    multiplies it by the transmission between the two levels (cap_level_decay), so a collision
+    costs two exps (water and air) whatever the number of levels."""
     m0w, m1w, m0a, m1a = cap_lookup(sc, sc.cap_table_of_layer[layer], -uz)
-    c = sc.layer_a[layer] + sc.layer_b[layer]
-    tau_here = sc.plane_tau[seg] + c * (z - sc.plane_z[seg])
+    tau_here = sc.plane_tau[seg] + sc.layer_c[layer] * (z - sc.plane_z[seg])
     mu = sc.cap_mu_w
-    for level in range(sc.level_z.shape[0]):
-        if sc.level_z[level] <= z:
+    above = 0
+    while above < sc.level_z.shape[0] and sc.level_z[above] <= z:
+        above += 1
+    if above > 0:
+        transmitted = math.exp(-(tau_here - sc.level_tau[above - 1]) / mu)
+        scale = w_scattered / (mu * sc.cap_omega_w)
+        for level in range(above - 1, -1, -1):
             dtau = tau_here - sc.level_tau[level]
-            g = math.exp(-dtau / mu) / mu
-            cap[level] += w_scattered * (m0w * g + m1w * g * (dtau / mu - 1.0) / mu) \
-                / sc.cap_omega_w
+            cap[level] += scale * transmitted * (m0w + m1w * (dtau / mu - 1.0) / mu)
+            transmitted *= sc.cap_level_decay[level]
     mu = sc.cap_mu_a
     e = math.exp(-tau_here / mu)
     cap[sc.level_z.shape[0]] += w_scattered * e * (

@@ -34,6 +34,13 @@ SKY_MAP = 2              # a tabulated radiance map, piecewise constant on its c
 SKY_HARRISON_COOMBES = 3  # Harrison & Coombes (1988) clear sky; a fine map as the proposal
 SKY_MAP_COSINE = 4       # a map sampled cosine-weighted, each photon weighted by its cell's L
 
+# Features a scene uses, as bits of the compile-time constant `features` of the photon loop
+# (kernel/driver.py): code for a feature a scene does not use is not compiled into its loop.
+FEATURE_SKY = 1          # sky photons (diffuse_fraction > 0)
+FEATURE_BOTTOM = 2       # a reflecting bottom (not none or black)
+FEATURE_RADIANCE = 4     # the radiance quad tallies
+FEATURE_ESTIMATES = 8    # local estimates: exact directions and/or the nadir polar cap
+
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0
 BUDGET_WATER_LEAVING = 1

@@ -12,7 +12,9 @@ SceneArrays = namedtuple("SceneArrays", [
     # surface
     "surface_flat", "n_water", "fresnel_schlick",
     # geometry and water
-    "plane_z", "plane_tally", "segment_layer", "layer_a", "layer_b",
+    "plane_z", "plane_tally", "segment_layer",
+    # per layer: extinction c = a + b, 1/c (0 when c = 0) and the single-scattering albedo b/c
+    "layer_c", "layer_inv_c", "layer_albedo",
     # phase functions: a layer's components layer_comp_start .. + layer_comp_count
     "layer_comp_start", "layer_comp_count", "comp_cumweight", "comp_model", "comp_params",
     "comp_tab_start", "comp_tab_len", "tab_psi", "tab_q", "tab_cdf",
@@ -27,7 +29,8 @@ SceneArrays = namedtuple("SceneArrays", [
     # distinct layer phase function on a two-piece uniform alpha grid
     "cap_estimates", "cap_table_of_layer", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a",
     "cap_fine_end", "cap_fine_step", "cap_coarse_step", "cap_fine_nodes",
-    "cap_mu_w", "cap_omega_w", "cap_cos_water", "cap_mu_a", "cap_omega_a", "cap_cos_air",
+    "cap_mu_w", "cap_omega_w", "cap_level_decay", "cap_cos_water", "cap_mu_a", "cap_omega_a",
+    "cap_cos_air",
     "cap_h", "cap_dh",
     # estimator
     "analog", "roulette_weight", "roulette_survival", "max_events",

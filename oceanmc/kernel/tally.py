@@ -11,7 +11,7 @@ import math
 
 from numba import njit
 
-from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
+from .models import FEATURE_RADIANCE, FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
 @njit(error_model="numpy", cache=True)
@@ -52,9 +52,10 @@ def phi_band(ux, uy, n_phi):
 
 @njit(error_model="numpy", cache=True, inline="always")
 def phi_band_fast(sc, ux, uy):
-    """phi_band without atan2: a polynomial guess of the azimuth (error < 0.003 rad; Rajan et
-    al. 2006, IEEE Signal Process. Mag. 23(3)), then exact tests against the band's edge
-    directions (sign of the 2-D cross product) move the guess to the right band."""
+    """phi_band without atan2: a polynomial guess of the azimuth (error < 0.0038 rad; Rajan et
+    al. 2006, IEEE Signal Process. Mag. 23(3)). The bands are equal, so a guess farther than
+    0.0063 rad (0.001 n bands) from an edge is the band; near an edge, exact tests against the
+    edge directions (sign of the 2-D cross product) move it to the right band."""
     n = sc.n_phi
     if n <= 2:
         return phi_band(ux, uy, n)
@@ -70,8 +71,12 @@ def phi_band_fast(sc, ux, uy):
         angle = math.pi - angle
     if uy < 0.0:
         angle = -angle
-    k = int(math.floor(angle * n / (2.0 * math.pi) + 0.5))
+    x = angle * n / (2.0 * math.pi) + 0.5
+    k = int(math.floor(x))
+    frac = x - k
     k = k + n if k < 0 else (k - n if k >= n else k)
+    if 0.001 * n < frac < 1.0 - 0.001 * n:
+        return k
     # band k lies between edge k (inclusive) and edge k + 1 (exclusive), counterclockwise
     while sc.phi_edge_cos[k] * uy - sc.phi_edge_sin[k] * ux < 0.0:
         k = k - 1 if k > 0 else n - 1
@@ -92,26 +97,34 @@ def inverse_mu(uz, mu_cut, beam):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score(sc, flux, radiance, level, w, ux, uy, uz, beam):
-    """A crossing of tally level `level` (an in-water depth, or the air levels after them);
-    beam: the packet is still part of the collimated solar beam."""
+def score_levels(sc, features, flux, radiance, level, second, w, ux, uy, uz, beam):
+    """A crossing of tally level `level` (an in-water depth, or the air levels after them), and
+    of level `second` too when second >= 0 (the same crossing counted twice: the bands are found
+    once); beam: the packet is still part of the collimated solar beam."""
     w_over_mu = w * inverse_mu(uz, sc.mu_cut, beam)
-    if uz > 0.0:
-        flux[level, FLUX_ED] += w
-        flux[level, FLUX_EOD] += w_over_mu
-    else:
-        flux[level, FLUX_EU] += w
-        flux[level, FLUX_EOU] += w_over_mu
-    if sc.tally_radiance:
+    col_e = FLUX_ED if uz > 0.0 else FLUX_EU
+    col_eo = FLUX_EOD if uz > 0.0 else FLUX_EOU
+    flux[level, col_e] += w
+    flux[level, col_eo] += w_over_mu
+    if second >= 0:
+        flux[second, col_e] += w
+        flux[second, col_eo] += w_over_mu
+    if features & FEATURE_RADIANCE:
         band = theta_band_fast(sc, uz)
         col = 0 if sc.theta_is_cap[band] else phi_band_fast(sc, ux, uy)
         radiance[level, band, col] += w_over_mu
+        if second >= 0:
+            radiance[second, band, col] += w_over_mu
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def score_air_up(sc, flux, radiance, w, ux, uy, uz, water_leaving, beam):
+def score(sc, features, flux, radiance, level, w, ux, uy, uz, beam):
+    score_levels(sc, features, flux, radiance, level, -1, w, ux, uy, uz, beam)
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def score_air_up(sc, features, flux, radiance, w, ux, uy, uz, water_leaving, beam):
     """Light travelling up at 0+: all of it at sc.air_level, and what came out of the water also
     at the water-leaving level after it."""
-    score(sc, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
-    if water_leaving:
-        score(sc, flux, radiance, sc.air_level + 1, w, ux, uy, uz, beam)
+    score_levels(sc, features, flux, radiance, sc.air_level,
+                 sc.air_level + 1 if water_leaving else -1, w, ux, uy, uz, beam)
