@@ -42,6 +42,8 @@ def photon_loop(sc, n_photons, seeds, flux, radiance, local, cap, budget, events
     argument types, as a function of (n_photons, seeds, flux, radiance, local, cap, budget,
     events); later calls must pass arrays of the same types (slices of the same tallies)."""
     features = features_of(sc)
+    if not hasattr(run_batches, "overloads"):  # NUMBA_DISABLE_JIT=1: plain Python
+        return lambda *tallies: run_batches(sc, features, *tallies)
     signature = (typeof(sc), types.literal(features)) + tuple(
         typeof(a) for a in (n_photons, seeds, flux, radiance, local, cap, budget, events))
     compiled = run_batches.overloads.get(signature)
