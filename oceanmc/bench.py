@@ -478,9 +478,10 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
         say(f"error vs time: {scene['name']} ...")
         if scene["reference"] is None:
             long_runs[scene["name"]] = long_run_reference(scene, reference_photons, 2, say)
+        shared = long_runs[scene["reference"]] if isinstance(scene["reference"], str) else None
         data["error_vs_time"].append(error_vs_time(
             scene, counts, reference_photons, 2, say,
-            reference=long_runs.get(scene["name"], long_runs.get(scene["reference"]))))
+            reference=long_runs.get(scene["name"], shared)))
     spot_counts = [10_000, 20_000] if quick else [100_000, 400_000, 1_600_000]
     spot_reference_photons = 40_000 if quick else 8_000_000
     with tempfile.TemporaryDirectory() as tmp:

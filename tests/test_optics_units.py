@@ -8,7 +8,7 @@ from scipy import integrate
 
 import oceanmc
 from oceanmc import scene
-from oceanmc.kernel.geometry import from_angles, turn
+from oceanmc.kernel.geometry import cos_sin_turn, from_angles, turn
 from oceanmc.kernel.interface import fresnel, refract
 
 from stats_helpers import fresnel_reference
@@ -194,10 +194,33 @@ def test_turn_keeps_the_scattering_angle():
         cases.append(tuple(v / np.linalg.norm(v)))
     for ux, uy, uz in cases:
         for cos_t in (1.0, 0.9999, 0.5, 0.0, -0.3, -1.0, float(rng.uniform(-1, 1))):
-            phi = float(rng.uniform(0.0, 2.0 * math.pi))
-            nx, ny, nz = turn(ux, uy, uz, cos_t, phi)
+            nx, ny, nz = turn(ux, uy, uz, cos_t, float(rng.random()))
             assert nx * nx + ny * ny + nz * nz == pytest.approx(1.0, abs=1e-12)
             assert nx * ux + ny * uy + nz * uz == pytest.approx(cos_t, abs=1e-9)
+
+
+def test_cos_sin_turn_is_exact_to_rounding():
+    """The table + Taylor azimuth against libm over random u, every table node, the cells' last
+    values and the largest u below 1: within 8 ulp of 1 (libm and the rounding of 2 pi u
+    included), and on the unit circle."""
+    rng = np.random.default_rng(12)
+    nodes = np.arange(1024) / 1024
+    u = np.concatenate([rng.random(200_000), nodes, np.nextafter(nodes[1:], 0.0),
+                        [np.nextafter(1.0, 0.0)]])
+    cos_sin = np.array([cos_sin_turn(float(x)) for x in u])
+    phi = 2.0 * np.pi * u
+    assert np.abs(cos_sin[:, 0] - np.cos(phi)).max() <= 8 * np.finfo(float).eps
+    assert np.abs(cos_sin[:, 1] - np.sin(phi)).max() <= 8 * np.finfo(float).eps
+    assert np.abs((cos_sin ** 2).sum(axis=1) - 1.0).max() <= 8 * np.finfo(float).eps
+
+
+def test_turn_keeps_unit_length_over_many_turns():
+    """The Newton renormalisation (no sqrt) holds the length at 1 over a long walk."""
+    rng = np.random.default_rng(13)
+    ux, uy, uz = 0.0, 0.0, 1.0
+    for _ in range(100_000):
+        ux, uy, uz = turn(ux, uy, uz, float(rng.uniform(0.999, 1.0)), float(rng.random()))
+    assert abs(ux * ux + uy * uy + uz * uz - 1.0) < 1e-15
 
 
 def test_turn_azimuth_is_uniform():
@@ -210,7 +233,7 @@ def test_turn_azimuth_is_uniform():
     e1 /= np.linalg.norm(e1)
     rng = np.random.default_rng(8)
     cos_t = 0.6
-    proj = np.array([np.dot(turn(u[0], u[1], u[2], cos_t, 2 * math.pi * x), e1)
+    proj = np.array([np.dot(turn(u[0], u[1], u[2], cos_t, x), e1)
                      for x in rng.random(20_000)])
     sin2 = 1.0 - cos_t ** 2
     assert abs(proj.mean()) < 4.0 * math.sqrt(sin2 / 2 / proj.size)
