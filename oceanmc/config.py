@@ -152,11 +152,14 @@ class Water(_Strict):
 
 class SkyMap(_Strict):
     """A sky radiance map from a file (sky_maps.py): an equirectangular (theta_view, phi_view)
-    array in .npy, .npz or HDF5; its absolute scale is irrelevant (the sky's share of Ed0 is
-    diffuse_fraction). sampling: importance draws directions in proportion to L cos dOmega
-    (every sky photon has the same weight); cosine draws them cosine-weighted over the
-    hemisphere whatever L, each photon weighted by L(its cell) pi / E with E the integral of
-    L cos dOmega: the same expectation, far more noise for a peaked map (for comparisons)."""
+    array in .npy, .npz or HDF5, or an OpenEXR image (.exr; the upper half of a 2:1 full-sphere
+    image); its absolute scale is irrelevant (the sky's share of Ed0 is diffuse_fraction).
+    dataset: the array in a .npz / HDF5 file; in an .exr, the channel to read (by default Y if
+    present, else the Rec. 709 luminance of R, G, B). sampling: importance draws directions in
+    proportion to L cos dOmega (every sky photon has the same weight); cosine draws them
+    cosine-weighted over the hemisphere whatever L, each photon weighted by L(its cell) pi / E
+    with E the integral of L cos dOmega: the same expectation, far more noise for a peaked map
+    (for comparisons)."""
     map: str
     dataset: str = "radiance"
     sampling: Literal["importance", "cosine"] = "importance"

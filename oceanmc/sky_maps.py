@@ -19,7 +19,23 @@ theta_view and azimuth phi_view, on an equirectangular grid of cells, each of co
     at the zenith), columns phi_view 0..360 deg in equal steps (column 0 starting at 0);
   - .npz or HDF5 (.h5, .hdf5): the array `radiance` (or the name given as `dataset`), optionally
     with `theta_edges_deg` (n_theta + 1, strictly increasing from 0 to 90) and `phi_edges_deg`
-    (n_phi + 1, strictly increasing, spanning exactly 360 deg).
+    (n_phi + 1, strictly increasing, spanning exactly 360 deg);
+  - OpenEXR (.exr), read with the OpenEXR package: a single-part scanline or tiled image whose
+    pixel rows are theta_view rows and columns phi_view columns, in equal steps, as for .npy
+    (image row 0, the top, at the zenith; column 0, the left, starting at phi_view = 0). An image
+    exactly twice as wide as it is high is a full-sphere equirectangular panorama (the common
+    HDRI layout: rows cover theta_view 0..180 deg) and only its upper half (rows 0..height/2 - 1,
+    the sky) is used; its height must then be even. Any other shape is the upper hemisphere
+    alone (rows 0..90 deg). So a hemisphere map must not be twice as wide as it is high (use,
+    e.g., 90 x 360 rather than 90 x 180 cells, or a .npy file). The radiance is the channel
+    named `dataset` if the image has one; otherwise, with the default `dataset` (radiance), the
+    channel Y if present, else the luminance of the linear R, G, B channels with the Rec. 709 /
+    sRGB primaries and D65 white, Y = 0.2126 R + 0.7152 G + 0.0722 B (ITU-R BT.709-6, item 3.2;
+    the Y row of the RGB -> XYZ matrix of IEC 61966-2-1:1999, sRGB). An image whose header
+    declares other primaries (a `chromaticities` attribute not Rec. 709 to 1e-3, or a
+    `colorInteropID` other than lin_rec709_scene) is refused for this conversion: give it a Y
+    channel or name a channel. Other channels (A, depth, ...) are ignored. The data window must
+    be the display window. No flip or rotation is applied: orient the image to the frame below.
 phi_view is measured in oceanmc's frame: from the horizontal direction in which the sun's rays
 travel (DESIGN.md section 1), so the sun itself is seen at phi_view = 180 deg. A photon coming
 from the viewed element travels the opposite way: theta_travel (from nadir) = theta_view and
@@ -45,7 +61,12 @@ sampling gains (oceanmc bench: a small bright spot), or to check it.
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import math
+import os
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -57,9 +78,123 @@ from .phase_tables import TableError
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
 HC_GAUSS = 8              # Gauss points per cell side for its cell averages
 
+# Luminance of linear RGB with the Rec. 709 / sRGB primaries and D65 white: ITU-R BT.709-6
+# (2015), item 3.2; the Y row of the RGB -> XYZ matrix of IEC 61966-2-1:1999 (sRGB).
+REC709_Y = (0.2126, 0.7152, 0.0722)
+# (red x, y, green x, y, blue x, y, white x, y) of Rec. 709 / sRGB (BT.709-6 items 1.3, 1.4),
+# in the order of the OpenEXR `chromaticities` header attribute
+REC709_CHROMATICITIES = (0.64, 0.33, 0.30, 0.60, 0.15, 0.06, 0.3127, 0.3290)
+
 
 def _fail(path, problem: str):
     raise TableError(f"sky map {path}: {problem}")
+
+
+def _call_quietly(fn):
+    """(fn(), None, printed) or (None, the exception, printed), printed being the non-empty lines
+    the library wrote meanwhile: the OpenEXR bindings print warnings to sys.stdout and
+    OpenEXRCore writes its errors straight to file descriptor 2; both are collected here so that
+    a bad file gives one error message and nothing else on the terminal."""
+    out = io.StringIO()
+    result, exc = None, None
+    with tempfile.TemporaryFile() as err, contextlib.redirect_stdout(out):
+        try:
+            sys.stderr.flush()
+            saved = os.dup(2)
+        except (OSError, ValueError, AttributeError):
+            saved = None          # no usable descriptor 2: let the messages through
+        if saved is not None:
+            os.dup2(err.fileno(), 2)
+        try:
+            result = fn()
+        except Exception as e:    # the bindings raise RuntimeError, ValueError, ...
+            exc = e
+        finally:
+            if saved is not None:
+                os.dup2(saved, 2)
+                os.close(saved)
+        err.seek(0)
+        printed = err.read().decode("utf-8", errors="replace") + "\n" + out.getvalue()
+    return result, exc, [line.strip() for line in printed.splitlines() if line.strip()]
+
+
+def _pixels(path, channels: dict, name: str, shape: tuple[int, int], rows: int) -> np.ndarray:
+    """The first `rows` rows of one channel's pixels as float64, checked (full resolution,
+    real; finite and >= 0 in those rows: the ground of a full-sphere image is not read)."""
+    ch = channels[name]
+    px = np.asarray(ch.pixels)
+    if px.shape != shape or ch.xSampling != 1 or ch.ySampling != 1:
+        _fail(path, f"channel {name!r} is subsampled or misshapen ({px.shape}, sampling "
+                    f"{ch.xSampling} x {ch.ySampling}); the image is {shape[0]} x {shape[1]} "
+                    f"pixels")
+    if not np.issubdtype(px.dtype, np.number) or np.iscomplexobj(px):
+        _fail(path, f"channel {name!r} is not real numbers ({px.dtype})")
+    px = px[:rows].astype(np.float64)
+    if not np.all(np.isfinite(px)):
+        k = np.argwhere(~np.isfinite(px))[0]
+        _fail(path, f"channel {name!r} contains NaN or inf (at pixel row {k[0]}, column {k[1]})")
+    if np.any(px < 0.0):
+        k = np.argwhere(px < 0.0)[0]
+        _fail(path, f"negative value {px[k[0], k[1]]:g} in channel {name!r} at pixel row {k[0]}, "
+                    f"column {k[1]}")
+    return px
+
+
+def _read_exr(path, dataset: str) -> np.ndarray:
+    """The radiance (n_theta, n_phi) of an equirectangular OpenEXR sky image (module docstring):
+    the channel `dataset`, else Y, else the Rec. 709 luminance of R, G, B; the upper half of a
+    full-sphere image (width = 2 height)."""
+    try:
+        import OpenEXR
+    except ImportError as exc:
+        _fail(path, f"reading .exr needs the OpenEXR package (pip install 'OpenEXR>=3.3'): {exc}")
+    f, exc, printed = _call_quietly(lambda: OpenEXR.File(str(path), separate_channels=True))
+    if exc is not None or f is None or len(f.parts) == 0:
+        why = printed[0] if printed else (str(exc) if exc is not None else "no image in it")
+        _fail(path, f"cannot read it as OpenEXR ({why})")
+    if len(f.parts) > 1:
+        _fail(path, f"has {len(f.parts)} parts; oceanmc reads single-part images")
+    header = f.header()
+    if "deep" in str(header.get("type", "")).lower():
+        _fail(path, "is a deep image; oceanmc reads flat (scanline or tiled) images")
+    data_win = [np.asarray(v).tolist() for v in header.get("dataWindow", ())]
+    disp_win = [np.asarray(v).tolist() for v in header.get("displayWindow", ())]
+    if data_win != disp_win:
+        _fail(path, f"its data window {data_win} is not its display window {disp_win}; the "
+                    f"pixels must cover the whole equirectangular image")
+    channels = f.channels()
+    part = f.parts[0]
+    shape = (int(part.height()), int(part.width()))
+    rows = shape[0]
+    if 2 * shape[0] == shape[1]:              # full sphere, rows 0..180 deg: keep the sky
+        if shape[0] % 2:
+            _fail(path, f"a full-sphere image ({shape[0]} x {shape[1]} pixels, width = 2 x "
+                        f"height) needs an even height, so that the horizon falls between two "
+                        f"rows")
+        rows = shape[0] // 2
+    names = sorted(channels)
+    if dataset in channels:
+        return _pixels(path, channels, dataset, shape, rows)
+    if dataset != "radiance":
+        _fail(path, f"no channel {dataset!r} (found: {names or 'nothing'})")
+    if "Y" in channels:
+        return _pixels(path, channels, "Y", shape, rows)
+    if not all(c in channels for c in "RGB"):
+        _fail(path, f"no channel 'radiance' or 'Y', nor all of 'R', 'G', 'B' (found: "
+                    f"{names or 'nothing'}); name the radiance channel with dataset")
+    chroma = header.get("chromaticities")
+    if chroma is not None and not np.allclose(np.asarray(chroma, dtype=np.float64),
+                                              REC709_CHROMATICITIES, rtol=0.0, atol=1e-3):
+        _fail(path, f"its RGB primaries (chromaticities {tuple(round(c, 4) for c in chroma)}) "
+                    f"are not Rec. 709 / sRGB, so Y = 0.2126 R + 0.7152 G + 0.0722 B does not "
+                    f"apply; give it a Y channel or name a channel with dataset")
+    interop = header.get("colorInteropID")
+    if interop is not None and str(interop) != "lin_rec709_scene":
+        _fail(path, f"its colorInteropID is {str(interop)!r}, not linear Rec. 709 "
+                    f"(lin_rec709_scene), so Y = 0.2126 R + 0.7152 G + 0.0722 B does not apply; "
+                    f"give it a Y channel or name a channel with dataset")
+    r, g, b = (_pixels(path, channels, c, shape, rows) for c in "RGB")
+    return REC709_Y[0] * r + REC709_Y[1] * g + REC709_Y[2] * b
 
 
 def _edges(path, data: dict, name: str, n: int, span: tuple[float, float] | None) -> np.ndarray:
@@ -113,8 +248,10 @@ def read_sky_map(path, dataset: str = "radiance") -> tuple[np.ndarray, np.ndarra
                         if isinstance(h5[k], h5py.Dataset)}
         except (OSError, ValueError, TypeError) as exc:
             _fail(path, f"cannot read it as HDF5 ({exc})")
+    elif suffix == ".exr":
+        data[dataset] = _read_exr(path, dataset)
     else:
-        _fail(path, f"unknown file type {suffix!r}; use .npy, .npz or .h5/.hdf5")
+        _fail(path, f"unknown file type {suffix!r}; use .npy, .npz, .h5/.hdf5 or .exr")
     if dataset not in data:
         _fail(path, f"no array {dataset!r} (found: {sorted(data) or 'nothing'})")
     L = np.asarray(data[dataset])

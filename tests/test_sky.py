@@ -12,11 +12,21 @@ averaging to 1. Through the engine: a uniform map, importance- or cosine-sampled
 the same tallies under both samplings; Harrison-Coombes gives the surface reflectance and the
 sky radiance quads of the formula. Bad files give one ConfigError naming the file and the
 problem.
+
+OpenEXR sky images (.exr): the reader returns exactly the channel Y, or the Rec. 709 luminance
+0.2126 R + 0.7152 G + 0.0722 B, or the channel named as `dataset`, oriented as a .npy map (row 0
+= zenith, column 0 = phi_view 0), the upper half of a full-sphere (2:1) image; the same map as
+.exr and as .npy gives bit-identical sampling tables; bad images give one error naming the file,
+also on the command line (one line, exit 2).
 """
 import math
+import os
+import subprocess
+import sys
 
 import h5py
 import numpy as np
+import OpenEXR
 import pytest
 
 import oceanmc
@@ -24,6 +34,7 @@ from oceanmc import scene, sky_maps
 from oceanmc.config import ConfigError, load_config
 from oceanmc.kernel.sources import sky_many
 
+from conftest import REPO
 from stats_helpers import (assert_chi2, assert_same, assert_z, batch_mean_se, fresnel_reference,
                            sample_mean_se)
 
@@ -432,3 +443,178 @@ def test_sky_config(tmp_path):
     import yaml
     again = load_config(yaml.safe_load(config_to_yaml(config)))
     assert again.illumination.sky == config.illumination.sky
+
+
+# --- OpenEXR sky images -----------------------------------------------------------------------
+
+def write_exr(path, channels, header=None):
+    """A single-part scanline OpenEXR image with the given {name: 2-D float16/float32 array}."""
+    OpenEXR.File(dict({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
+                      **(header or {})), channels).write(str(path))
+    return path
+
+
+def exr_sky(rows=6, cols=16):
+    """R, G, B (float32) of a hemisphere map: a smooth background, one bright patch at rows 1-2,
+    columns 3-4 (theta_view 15-45 deg, phi_view 67.5-112.5 deg for 6 x 16), a pure-red, a
+    pure-green and a pure-blue pixel of value 1 in the last row, columns 9-11."""
+    t = np.arange(rows)[:, None]
+    p = np.arange(cols)[None, :]
+    R = (1.0 + 0.1 * t + 0.01 * p).astype(np.float32)
+    G = (2.0 + 0.05 * t - 0.02 * np.cos(p)).astype(np.float32)
+    B = (0.5 + 0.2 * np.sin(p) ** 2 + 0.03 * t).astype(np.float32)
+    for c in (R, G, B):
+        c[1:3, 3:5] *= 40.0
+        c[-1, 9:12] = 0.0
+    R[-1, 9], G[-1, 10], B[-1, 11] = 1.0, 1.0, 1.0
+    return R, G, B
+
+
+def luminance(R, G, B):
+    return (0.2126 * R.astype(np.float64) + 0.7152 * G.astype(np.float64)
+            + 0.0722 * B.astype(np.float64))
+
+
+def test_exr_map_reading(tmp_path):
+    R, G, B = exr_sky()
+    Y = (0.3 * R + 0.6 * G + 0.1 * B).astype(np.float32)   # not the Rec. 709 weights
+    # RGB only: the Rec. 709 luminance, oriented as the image (row 0 = zenith, column 0 = phi 0)
+    theta, phi, L = sky_maps.read_sky_map(write_exr(tmp_path / "rgb.exr",
+                                                    {"R": R, "G": G, "B": B}))
+    assert L.dtype == np.float64 and L.shape == (6, 16)
+    np.testing.assert_array_equal(L, luminance(R, G, B))
+    assert L[-1, 9] == 0.2126 and L[-1, 10] == 0.7152 and L[-1, 11] == 0.0722
+    assert np.unravel_index(np.argmax(L), L.shape) in {(1, 3), (1, 4), (2, 3), (2, 4)}
+    assert L[0, 0] < L[1, 3] / 20 and L[5, 3] < L[2, 3] / 20
+    np.testing.assert_array_equal(theta, np.linspace(0.0, 90.0, 7))
+    np.testing.assert_array_equal(phi, np.linspace(0.0, 360.0, 17))
+    # alpha and other channels beside R, G, B are ignored
+    _, _, L2 = sky_maps.read_sky_map(write_exr(tmp_path / "rgba.exr", {
+        "R": R, "G": G, "B": B, "A": np.full_like(R, 0.5), "Z": -np.ones_like(R)}))
+    np.testing.assert_array_equal(L2, L)
+    # a Y channel wins over R, G, B; half floats are read as they are stored
+    _, _, LY = sky_maps.read_sky_map(write_exr(tmp_path / "ry.exr",
+                                               {"R": R, "G": G, "B": B, "Y": Y}))
+    np.testing.assert_array_equal(LY, Y.astype(np.float64))
+    Yh = Y.astype(np.float16)
+    _, _, LH = sky_maps.read_sky_map(write_exr(tmp_path / "half.exr", {"Y": Yh}))
+    np.testing.assert_array_equal(LH, Yh.astype(np.float64))
+    # dataset names a channel, also one in a layer; uint pixels are read as they are
+    _, _, LG = sky_maps.read_sky_map(tmp_path / "ry.exr", "G")
+    np.testing.assert_array_equal(LG, G.astype(np.float64))
+    _, _, LB = sky_maps.read_sky_map(write_exr(tmp_path / "layer.exr", {
+        "sky.R": R, "sky.G": G, "sky.B": B, "Y": Y}), "sky.B")
+    np.testing.assert_array_equal(LB, B.astype(np.float64))
+    U = np.arange(1, 6 * 16 + 1, dtype=np.uint32).reshape(6, 16)
+    _, _, LU = sky_maps.read_sky_map(write_exr(tmp_path / "uint.exr", {"Y": U}))
+    np.testing.assert_array_equal(LU, U.astype(np.float64))
+    # full sphere (width = 2 x height): rows 0..180 deg; only the upper half (the sky) is read,
+    # the ground below may hold anything
+    sphere = np.concatenate([Y[:4], np.full((4, 16), -7.0, np.float32)])
+    sphere[5, 2] = np.nan
+    _, _, LS = sky_maps.read_sky_map(write_exr(tmp_path / "sphere.exr", {"Y": sphere}))
+    np.testing.assert_array_equal(LS, Y[:4].astype(np.float64))
+    # any other shape is the upper hemisphere: 4 x 16, 8 x 15 and 8 x 17 are read whole
+    for shape in ((4, 16), (8, 15), (8, 17)):
+        img = np.random.default_rng(1).uniform(0.5, 2.0, shape).astype(np.float32)
+        theta, phi, Lh = sky_maps.read_sky_map(write_exr(tmp_path / "h.exr", {"Y": img}))
+        np.testing.assert_array_equal(Lh, img.astype(np.float64))
+        assert theta.size == shape[0] + 1 and phi.size == shape[1] + 1
+
+
+def assert_same_fields(a, b):
+    assert sorted(a) == sorted(b)
+    for key in a:
+        x, y = np.asarray(a[key]), np.asarray(b[key])
+        assert x.dtype == y.dtype and x.shape == y.shape, key
+        assert np.array_equal(x, y), key
+
+
+@pytest.mark.parametrize("sampling", ["importance", "cosine"])
+def test_exr_map_same_tables_as_npy(tmp_path, sampling):
+    """The same map as .exr (RGB luminance; Y of a full sphere) and as .npy gives bit-identical
+    sky fields."""
+    R, G, B = exr_sky(rows=9, cols=24)
+    write_exr(tmp_path / "rgb.exr", {"R": R, "G": G, "B": B})
+    np.save(tmp_path / "rgb.npy", luminance(R, G, B))
+    Y = np.random.default_rng(2).uniform(0.1, 3.0, (10, 20)).astype(np.float32)
+    Y[1, 7] = 300.0
+    write_exr(tmp_path / "sphere.exr", {"Y": Y})
+    np.save(tmp_path / "sphere.npy", Y[:5].astype(np.float64))
+    for name in ("rgb", "sphere"):
+        fields = [sky_maps.sky_fields(load_config(base(
+            {"map": str(tmp_path / f"{name}.{ext}"), "sampling": sampling})).illumination)
+            for ext in ("exr", "npy")]
+        assert_same_fields(*fields)
+        assert fields[0]["sky_cell_L"].shape == ((9, 24) if name == "rgb" else (5, 20))
+    # and through the whole scene
+    a, _ = scene.build(load_config(base({"map": str(tmp_path / "rgb.exr"),
+                                         "sampling": sampling})))
+    b, _ = scene.build(load_config(base({"map": str(tmp_path / "rgb.npy"),
+                                         "sampling": sampling})))
+    for key in ("sky_model", "sky_s_edges", "sky_phi_edges", "sky_row_cdf", "sky_cell_cdf",
+                "sky_cell_L", "sky_params"):
+        assert np.array_equal(np.asarray(getattr(a, key)), np.asarray(getattr(b, key))), key
+
+
+def test_bad_exr_files(tmp_path):
+    ok = np.ones((5, 8), np.float32)       # not 2:1, so every row is sky
+    neg = ok.copy()
+    neg[2, 5] = -0.25
+    nan = ok.copy()
+    nan[1, 6] = np.nan
+    write_exr(tmp_path / "neg.exr", {"Y": neg})
+    write_exr(tmp_path / "negred.exr", {"R": neg, "G": ok, "B": ok})
+    write_exr(tmp_path / "nan.exr", {"R": ok, "G": ok, "B": nan})
+    write_exr(tmp_path / "inf.exr", {"Y": np.array([[1.0, np.inf], [1.0, 1.0]], np.float16)})
+    write_exr(tmp_path / "odd.exr", {"Y": np.ones((3, 6), np.float32)})
+    write_exr(tmp_path / "depth.exr", {"Z": ok, "A": ok})
+    write_exr(tmp_path / "ap0.exr", {"R": ok, "G": ok, "B": ok}, {"chromaticities": (
+        0.7347, 0.2653, 0.0, 1.0, 0.0001, -0.077, 0.32168, 0.33767)})
+    write_exr(tmp_path / "dark.exr", {"Y": np.zeros((5, 8), np.float32)})
+    OpenEXR.File([OpenEXR.Part({}, {"Y": ok}, name="a"),
+                  OpenEXR.Part({}, {"Y": ok}, name="b")]).write(str(tmp_path / "parts.exr"))
+    (tmp_path / "junk.exr").write_bytes(b"not an OpenEXR image at all, just some bytes")
+    good = write_exr(tmp_path / "good.exr", {"Y": np.ones((40, 50), np.float32)},
+                     {"compression": OpenEXR.NO_COMPRESSION}).read_bytes()
+    (tmp_path / "cut.exr").write_bytes(good[: len(good) // 2])
+    (tmp_path / "empty.exr").write_bytes(b"")
+    cases = {"neg.exr": "negative value -0.25 in channel 'Y' at pixel row 2, column 5",
+             "negred.exr": "negative value -0.25 in channel 'R' at pixel row 2, column 5",
+             "nan.exr": "channel 'B' contains NaN or inf (at pixel row 1, column 6)",
+             "inf.exr": "channel 'Y' contains NaN or inf (at pixel row 0, column 1)",
+             "odd.exr": "needs an even height",
+             "depth.exr": "no channel 'radiance' or 'Y', nor all of 'R', 'G', 'B' (found: "
+                          "['A', 'Z'])",
+             "ap0.exr": "not Rec. 709", "dark.exr": "dark everywhere",
+             "parts.exr": "has 2 parts", "junk.exr": "cannot read it as OpenEXR",
+             "cut.exr": "cannot read it as OpenEXR", "empty.exr": "is empty",
+             "missing.exr": "no such file"}
+    for name, words in cases.items():
+        msg = sky_error(tmp_path / name)
+        assert msg.startswith(f"sky map {tmp_path / name}: ") and words in msg, (name, msg)
+        assert "\n" not in msg, (name, msg)
+    msg = sky_error(tmp_path / "good.exr", dataset="radiance.Y")
+    assert "no channel 'radiance.Y' (found: ['Y'])" in msg, msg
+    # the right channel named: read
+    scene.build(load_config(base({"map": str(tmp_path / "depth.exr"), "dataset": "A"})))
+
+
+def test_bad_exr_on_the_command_line(tmp_path):
+    """A truncated image (OpenEXRCore prints its own error to file descriptor 2, the bindings a
+    warning to stdout): one line on stderr naming the file, nothing on stdout, exit 2."""
+    good = write_exr(tmp_path / "good.exr", {"Y": np.ones((40, 50), np.float32)},
+                     {"compression": OpenEXR.NO_COMPRESSION}).read_bytes()
+    (tmp_path / "cut.exr").write_bytes(good[: len(good) // 2])
+    (tmp_path / "scene.yaml").write_text(
+        "water: {layers: [{thickness_m: 1, a: 0.1, b: 0}]}\nbottom: {model: black}\n"
+        "illumination: {diffuse_fraction: 0.5, sky: {map: cut.exr}}\n")
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "run", "scene.yaml", "-o", "x.h5"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600,
+                          env=dict(os.environ, PYTHONPATH=str(REPO)))
+    assert done.returncode == 2, done.stderr
+    assert done.stdout == "", done.stdout
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
+    assert f"sky map {tmp_path / 'cut.exr'}: cannot read it as OpenEXR" in lines[0], lines[0]
+    assert not (tmp_path / "x.h5").exists()
