@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal, Optional, Union
 
 import yaml
 from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
@@ -338,11 +338,14 @@ class Tallies(_Strict):
 class Estimator(_Strict):
     """How photon weights evolve. `implicit`: absorption and Fresnel splitting by weight, with
     Russian roulette below `roulette_weight` (survivors get weight / roulette_survival).
-    `analog`: absorption, Fresnel and bottom reflection decided by random draws (for tests)."""
+    `analog`: absorption, Fresnel and bottom reflection decided by random draws (for tests).
+    split_weight: a packet heavier than this (a launched packet weighs 1) is split into
+    floor(w / split_weight) + 1 packets of equal weight; off (null) by default."""
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
     max_events: Annotated[int, Field(ge=100)] = 1_000_000
+    split_weight: Optional[Annotated[float, Field(gt=1.0, allow_inf_nan=False)]] = None
 
 
 class SceneConfig(_Strict):

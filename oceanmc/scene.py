@@ -328,6 +328,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         roulette_weight=float(config.estimator.roulette_weight),
         roulette_survival=float(config.estimator.roulette_survival),
         max_events=int(config.estimator.max_events),
+        split_weight=float(config.estimator.split_weight or math.inf),
         **{name: 0 for name in SceneArrays._fields if name.startswith("cap_")},
     )
     return sc._replace(**_cap_fields(config, sc, grid)), grid

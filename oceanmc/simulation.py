@@ -14,6 +14,7 @@ from tqdm import tqdm
 from . import __version__, scene
 from .config import SceneConfig, config_to_yaml, load_config
 from .kernel.driver import photon_loop
+from .kernel.models import SPLIT_STACK_ROWS, STACK_COLUMNS
 from .results import Result, budget_terms, from_tallies
 
 
@@ -82,10 +83,13 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     seeds = batch_seeds(config.seed, config.batches)[first_batch:]
     local_rows = scene.local_directions(config)[3]
     raw = allocate(sc, n_batches, len(depths), grid, n_layers)
+    # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
+    stack = np.zeros((n_batches, SPLIT_STACK_ROWS if math.isfinite(sc.split_weight) else 1,
+                      STACK_COLUMNS))
 
     t0 = time.perf_counter()
     # compiles this scene's loop (or loads it from the cache) outside the timing
-    loop = photon_loop(sc, n_per_batch, seeds, *_batches(raw, 0, 1))
+    loop = photon_loop(sc, n_per_batch, seeds, *_batches(raw, 0, 1), stack)
     startup = time.perf_counter() - t0
 
     def result_of(done: int, wall: float) -> Result:
@@ -119,7 +123,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
               disable=not progress, desc=config.name[:40], leave=False) as bar:
         while done < n_batches:
             hi = min(n_batches, done + group)
-            loop(n_per_batch, seeds[done:hi], *_batches(raw, done, hi))
+            loop(n_per_batch, seeds[done:hi], *_batches(raw, done, hi), stack[done:hi])
             bar.update((hi - done) * n_per_batch)
             done = hi
             if should_stop is not None and should_stop():

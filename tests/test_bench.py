@@ -21,15 +21,18 @@ def test_quick_bench_writes_report(tmp_path):
     assert {row["variant"] for row in data["features"]} >= {"no tallies at all",
                                                             "+ local nadir-cap estimate"}
     scenes = {curve["scene"] for curve in data["error_vs_time"]}
-    assert scenes == {"bare walk", "clear ocean", "shallow sand", "Snell's window",
+    assert scenes == {"bare walk", "clear ocean", "clear ocean, crossing estimator only",
+                      "shallow sand", "Snell's window",
                       "sky map with a small bright spot (importance sampling)",
-                      "sky map with a small bright spot (cosine sampling)"}
+                      "sky map with a small bright spot (cosine sampling)",
+                      "sky map with a small bright spot (cosine sampling, split_weight 2)"}
+    assert any(key.endswith("against a crossing-only run") for key in data["fom_ratios"])
     spot = {row["quantity"]: row for row in data["sky_sampling"]}
     assert len(spot) == 5 and "Ed(0-)" in spot
-    assert all(row["ratio"] > 0 for row in spot.values())
+    assert all(row["ratio"] > 0 and row["ratio_split"] > 0 for row in spot.values())
     snell = next(c for c in data["error_vs_time"] if c["scene"] == "Snell's window")
     assert snell["reference"] == "analytic"
     assert all(abs(row["z"]) < 5 for row in snell["rows"]), snell["rows"]
     assert (tmp_path / "b" / "error_vs_time.png").stat().st_size > 10_000
     report = (tmp_path / "b" / "bench.md").read_text()
-    assert "Speed ceiling" in report and "ratio importance / cosine" in report
+    assert "Speed ceiling" in report and "importance / cosine" in report

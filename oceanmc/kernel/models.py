@@ -40,6 +40,12 @@ FEATURE_SKY = 1          # sky photons (diffuse_fraction > 0)
 FEATURE_BOTTOM = 2       # a reflecting bottom (not none or black)
 FEATURE_RADIANCE = 4     # the radiance quad tallies
 FEATURE_ESTIMATES = 8    # local estimates: exact directions and/or the nadir polar cap
+FEATURE_SPLITTING = 16   # splitting of packets heavier than estimator.split_weight
+
+# Packets waiting after a split (transport.split): one row per packet, its start state.
+SPLIT_STACK_ROWS = 64
+STACK_Z, STACK_SEGMENT, STACK_WEIGHT, STACK_UX, STACK_UY, STACK_UZ, STACK_BEAM = range(7)
+STACK_COLUMNS = 7
 
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0

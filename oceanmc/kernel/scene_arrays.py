@@ -33,7 +33,7 @@ SceneArrays = namedtuple("SceneArrays", [
     "cap_cos_air",
     "cap_h", "cap_dh",
     # estimator
-    "analog", "roulette_weight", "roulette_survival", "max_events",
+    "analog", "roulette_weight", "roulette_survival", "max_events", "split_weight",
     # tabulated skies (sky_maps.py): cell edges in sin^2(theta_view) and phi_view (rad), the
     # marginal CDF over rows, conditional CDFs within rows, cell radiances, sky parameters
     "sky_s_edges", "sky_phi_edges", "sky_row_cdf", "sky_cell_cdf", "sky_cell_L", "sky_params",

@@ -37,7 +37,9 @@ from .geometry import from_angles, turn
 from .interface import reflectance, refract
 from .models import (BOTTOM_SPECULAR, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING,
-                     FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_SKY)
+                     FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_SKY, FEATURE_SPLITTING,
+                     STACK_BEAM, STACK_SEGMENT, STACK_UX, STACK_UY, STACK_UZ, STACK_WEIGHT,
+                     STACK_Z)
 from .phase import dispatch as phase
 from .sources import sky_direction
 from .tally import score, score_air_up
@@ -57,6 +59,29 @@ def survives_roulette(sc, w):
     if np.random.random() < sc.roulette_survival:
         return True, w / sc.roulette_survival
     return False, 0.0
+
+
+@njit(error_model="numpy", cache=True, inline="always")
+def split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam):
+    """Splitting by weight: a packet heavier than sc.split_weight becomes k = floor(w /
+    split_weight) + 1 packets of weight w / k, each lighter than split_weight, that go on
+    independently from the same state (the walk has no memory, so each is an unbiased copy;
+    Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2). All but one wait on the stack, as many as
+    it has room for (fewer, heavier copies are as unbiased). Returns (w, n_stacked)."""
+    copies = min(int(w / sc.split_weight) + 1, stack.shape[0] - n_stacked + 1)
+    if copies <= 1:
+        return w, n_stacked
+    w /= copies
+    for _ in range(copies - 1):
+        stack[n_stacked, STACK_Z] = z
+        stack[n_stacked, STACK_SEGMENT] = seg
+        stack[n_stacked, STACK_WEIGHT] = w
+        stack[n_stacked, STACK_UX] = ux
+        stack[n_stacked, STACK_UY] = uy
+        stack[n_stacked, STACK_UZ] = uz
+        stack[n_stacked, STACK_BEAM] = 1.0 if beam else 0.0
+        n_stacked += 1
+    return w, n_stacked
 
 
 @njit(error_model="numpy", cache=True, inline="always")
@@ -85,20 +110,20 @@ def enter_water(sc, features, w, ux, uy, uz, beam, flux, radiance, budget):
 
 
 @njit(error_model="numpy", cache=True, inline="always")
-def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap, budget):
-    """Follows one packet from just below the surface (travelling down) until it leaves, is
-    absorbed or loses roulette; returns its scattering count. beam: it belongs to the collimated
-    solar beam (until it scatters or meets a diffuse bottom)."""
+def trace_in_water(sc, features, z, seg, w, ux, uy, uz, beam, flux, radiance, local, cap,
+                   budget, stack, n_stacked):
+    """Follows one packet from depth z on plane or in segment seg (just below the surface, or a
+    split copy at the bottom) until it leaves, is absorbed or loses roulette; returns its
+    scattering count and the new number of packets on the stack. beam: it belongs to the
+    collimated solar beam (until it scatters or meets a diffuse bottom)."""
     n = sc.n_water
     plane_z = sc.plane_z
     bottom_plane = plane_z.shape[0] - 1
-    z = 0.0
-    seg = 0
     tau = exponential()
     events = 0
     while True:
         if w <= 0.0:
-            return events
+            return events, n_stacked
         layer = sc.segment_layer[seg]
         c = sc.layer_c[layer]
         albedo = sc.layer_albedo[layer]
@@ -125,7 +150,7 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
                 if sc.analog:
                     if np.random.random() >= albedo:
                         budget[BUDGET_LAYERS + layer] += w
-                        return events
+                        return events, n_stacked
                 else:
                     scattered = w * albedo
                     budget[BUDGET_LAYERS + layer] += w - scattered
@@ -137,28 +162,28 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
                 tau = exponential()
                 alive, w = survives_roulette(sc, w)
                 if not alive:
-                    return events
+                    return events, n_stacked
                 if events >= sc.max_events:
                     budget[BUDGET_TRUNCATED] += w
-                    return events
+                    return events, n_stacked
                 continue
             tau -= dist * c
         elif dist == math.inf:
             # no scattering and no plane ahead: down an infinitely deep clear layer, or level
             budget[(BUDGET_LAYERS + layer) if c > 0.0 else BUDGET_LOST_BELOW] += w
-            return events
+            return events, n_stacked
         elif c > 0.0:
             transmitted = math.exp(-c * dist)
             if sc.analog:
                 if np.random.random() >= transmitted:
                     budget[BUDGET_LAYERS + layer] += w
-                    return events
+                    return events, n_stacked
             else:
                 budget[BUDGET_LAYERS + layer] += w * (1.0 - transmitted)
                 w *= transmitted
         if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
             budget[BUDGET_LOST_BELOW] += w
-            return events
+            return events, n_stacked
 
         z = plane_z[target]
         level = sc.plane_tally[target]
@@ -170,14 +195,14 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
             if not sc.surface_flat:
                 score_air_up(sc, features, flux, radiance, w, ux, uy, uz, True, beam)
                 budget[BUDGET_WATER_LEAVING] += w
-                return events
+                return events, n_stacked
             r, cos_t = reflectance(sc, n, 1.0, -uz)
             if sc.analog:
                 if np.random.random() >= r:
                     ox, oy, oz = refract(ux, uy, uz, n, cos_t)
                     score_air_up(sc, features, flux, radiance, w, ox, oy, oz, True, beam)
                     budget[BUDGET_WATER_LEAVING] += w
-                    return events
+                    return events, n_stacked
             else:
                 leaving = w * (1.0 - r)
                 if leaving > 0.0:
@@ -189,7 +214,7 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
                 # probability r, carrying w, so its expectation is kept while a weak
                 # internally reflected packet costs no more than in an analog walk
                 if r < 1.0 and np.random.random() >= r:
-                    return events
+                    return events, n_stacked
             uz = -uz
             seg = 0
             if level >= 0 and w > 0.0:
@@ -197,7 +222,7 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
         elif target == bottom_plane:
             if not features & FEATURE_BOTTOM:  # black (an infinitely deep bottom is never met)
                 budget[BUDGET_BOTTOM] += w
-                return events
+                return events, n_stacked
             if features & FEATURE_ESTIMATES:
                 if sc.local_estimates:
                     local_estimate.score_bottom(sc, local, w, ux, uy, uz)
@@ -209,27 +234,29 @@ def trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local, cap
             if sc.analog:
                 if np.random.random() >= rho:
                     budget[BUDGET_BOTTOM] += w
-                    return events
+                    return events, n_stacked
             else:
                 budget[BUDGET_BOTTOM] += w * (1.0 - rho)
                 w *= rho
             seg = bottom_plane - 1
             if level >= 0 and w > 0.0:
                 score(sc, features, flux, radiance, level, w, ux, uy, uz, beam)
+            if features & FEATURE_SPLITTING and w > sc.split_weight:
+                w, n_stacked = split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam)
         else:
             seg = target if uz > 0.0 else target - 1
             continue
         alive, w = survives_roulette(sc, w)
         if not alive:
-            return events
+            return events, n_stacked
 
 
 @njit(error_model="numpy", cache=True, _nrt=False)
-def trace_batch(sc, features, n_photons, seed, flux, radiance, local, cap, budget):
+def trace_batch(sc, features, n_photons, seed, flux, radiance, local, cap, budget, stack):
     """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
     packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
     come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
-    scattering events."""
+    scattering events. A photon's split copies (stack) are traced before the next photon."""
     np.random.seed(seed)
     f = sc.diffuse_fraction
     if f <= 0.0:
@@ -261,7 +288,23 @@ def trace_batch(sc, features, n_photons, seed, flux, radiance, local, cap, budge
             beam = True
         else:
             enters, w, ux, uy, uz, beam = True, w_sun_in, sx, sy, sz, True
-        if enters:
-            events += trace_in_water(sc, features, w, ux, uy, uz, beam, flux, radiance, local,
-                                     cap, budget)
+        if not enters:
+            continue
+        z, seg, n_stacked = 0.0, 0, 0
+        if features & FEATURE_SPLITTING and w > sc.split_weight:
+            w, n_stacked = split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam)
+        while True:
+            traced, n_stacked = trace_in_water(sc, features, z, seg, w, ux, uy, uz, beam, flux,
+                                               radiance, local, cap, budget, stack, n_stacked)
+            events += traced
+            if n_stacked == 0:
+                break
+            n_stacked -= 1
+            z = stack[n_stacked, STACK_Z]
+            seg = int(stack[n_stacked, STACK_SEGMENT])
+            w = stack[n_stacked, STACK_WEIGHT]
+            ux = stack[n_stacked, STACK_UX]
+            uy = stack[n_stacked, STACK_UY]
+            uz = stack[n_stacked, STACK_UZ]
+            beam = stack[n_stacked, STACK_BEAM] > 0.5
     return events
