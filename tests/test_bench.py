@@ -22,11 +22,13 @@ def test_quick_bench_writes_report(tmp_path):
                                                             "+ local nadir-cap estimate"}
     scenes = {curve["scene"] for curve in data["error_vs_time"]}
     assert scenes == {"bare walk", "clear ocean", "clear ocean, crossing estimator only",
+                      "clear ocean, roulette at weight 1e-12",
                       "shallow sand", "Snell's window",
                       "sky map with a small bright spot (importance sampling)",
                       "sky map with a small bright spot (cosine sampling)",
                       "sky map with a small bright spot (cosine sampling, split_weight 2)"}
     assert any(key.endswith("against a crossing-only run") for key in data["fom_ratios"])
+    assert len(data["roulette_ratios"]) == 3
     spot = {row["quantity"]: row for row in data["sky_sampling"]}
     assert len(spot) == 5 and "Ed(0-)" in spot
     assert all(row["ratio"] > 0 and row["ratio_split"] > 0 for row in spot.values())
