@@ -13,8 +13,8 @@ from tqdm import tqdm
 
 from . import __version__, scene
 from .config import SceneConfig, config_to_yaml, load_config
-from .kernel.driver import photon_loop
-from .kernel.models import SPLIT_STACK_ROWS, STACK_COLUMNS
+from .kernel.driver import features_of, photon_loop
+from .kernel.models import FEATURE_SPLITTING, SPLIT_STACK_ROWS, STACK_COLUMNS
 from .results import Result, budget_terms, from_tallies
 
 
@@ -84,8 +84,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     local_rows = scene.local_directions(config)[3]
     raw = allocate(sc, n_batches, len(depths), grid, n_layers)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
-    stack = np.zeros((n_batches, SPLIT_STACK_ROWS if math.isfinite(sc.split_weight) else 1,
-                      STACK_COLUMNS))
+    splitting = features_of(sc) & FEATURE_SPLITTING
+    stack = np.zeros((n_batches, SPLIT_STACK_ROWS if splitting else 1, STACK_COLUMNS))
 
     t0 = time.perf_counter()
     # compiles this scene's loop (or loads it from the cache) outside the timing

@@ -108,6 +108,26 @@ def band_labels(edges, bands) -> list[str]:
     return [f"theta {edges[i]:g}-{edges[i + 1]:g}" for i in bands]
 
 
+def compare_symmetric_radiance(ctx: Ctx, r, rad: JK, edges: np.ndarray, bands, f, *,
+                               band_check: str, quad_check: str, quad_cap: tuple[float, float],
+                               points=None, band_counts: bool = False) -> np.ndarray:
+    """The band averages and every distinct quad of the given theta bands against an
+    azimuthally symmetric radiance f(|mu|) (a quad's reference is its band's average); the
+    quads' power caps count the photons per quad, the bands' only with band_counts. Returns the
+    band references."""
+    band_ref = band_refs(edges, bands, f, points)
+    per_batch = r.attrs["photons_per_batch"]
+    ctx.compare_jk(band_check, rad.mean(axis=-1)[bands], band_ref,
+                   labels=band_labels(edges, bands), rel_cap=ctx.pick(0.01, 0.03),
+                   counts=expected_counts(band_ref, bands, edges, per_batch, None)
+                   if band_counts else None)
+    q, ti, _, labels = quads(rad, edges, bands, r.coords["phi"])
+    qref = band_ref[np.searchsorted(bands, ti)]
+    ctx.compare_jk(quad_check, q, qref, labels=labels, rel_cap=ctx.pick(*quad_cap),
+                   counts=expected_counts(qref, ti, edges, per_batch, len(r.coords["phi"])))
+    return band_ref
+
+
 def _plt():
     import matplotlib
     matplotlib.use("Agg")
@@ -151,17 +171,9 @@ def case_brdf(ctx: Ctx) -> None:
             up = hemisphere_bands(edges, up=True)
             rad = JK.of(r, "radiance")[0]
             f = (lambda mu, k=k, mu_i=mu_i: ref.minnaert_radiance(rho, k, mu_i, mu))
-            band_ref = band_refs(edges, up, f)
-            pb = r.attrs["photons_per_batch"]
-            ctx.compare_jk(f"{tag}: band-averaged reflected radiance", rad.mean(axis=-1)[up],
-                           band_ref, labels=band_labels(edges, up),
-                           rel_cap=ctx.pick(0.01, 0.03),
-                           counts=expected_counts(band_ref, up, edges, pb, None))
-            q, ti, _, labels = quads(rad, edges, up, r.coords["phi"])
-            qref = band_ref[np.searchsorted(up, ti)]
-            ctx.compare_jk(f"{tag}: quad radiance", q, qref, labels=labels,
-                           rel_cap=ctx.pick(0.04, 0.12),
-                           counts=expected_counts(qref, ti, edges, pb, len(r.coords["phi"])))
+            compare_symmetric_radiance(ctx, r, rad, edges, up, f, band_counts=True,
+                                       band_check=f"{tag}: band-averaged reflected radiance",
+                                       quad_check=f"{tag}: quad radiance", quad_cap=(0.04, 0.12))
             if th == 30.0:
                 polar[label_m] = (r, edges, up, rad, k, mu_i)
 
@@ -246,16 +258,10 @@ def _sky_manhole(ctx: Ctx, sky: str, photons: int):
     inside = np.array([i for i in down if edges[i] < theta_c])
     outside = np.array([i for i in down if edges[i] >= theta_c])
     f = (lambda mu: float(ref.radiance_below_surface(N_WATER, sky, mu)))
-    band_ref = band_refs(edges, inside, f, points=[mu_c])
-    ctx.compare_jk(f"{sky} sky: band-averaged L(0-) inside Snell's window vs t n^2 L_sky",
-                   rad.mean(axis=-1)[inside], band_ref, labels=band_labels(edges, inside),
-                   rel_cap=ctx.pick(0.01, 0.03))
-    q, ti, _, labels = quads(rad, edges, inside, r.coords["phi"])
-    qref = band_ref[np.searchsorted(inside, ti)]
-    ctx.compare_jk(f"{sky} sky: quad L(0-) inside Snell's window", q, qref, labels=labels,
-                   rel_cap=ctx.pick(0.03, 0.09),
-                   counts=expected_counts(qref, ti, edges, r.attrs["photons_per_batch"],
-                                          len(r.coords["phi"])))
+    band_ref = compare_symmetric_radiance(
+        ctx, r, rad, edges, inside, f, points=[mu_c], quad_cap=(0.03, 0.09),
+        band_check=f"{sky} sky: band-averaged L(0-) inside Snell's window vs t n^2 L_sky",
+        quad_check=f"{sky} sky: quad L(0-) inside Snell's window")
     ctx.exact(f"{sky} sky: L(0-) on quads beyond the critical angle (no light there)",
               rad.value[outside, :], 0.0)
     return r, edges, inside, rad, band_ref
@@ -645,16 +651,10 @@ def case_chandrasekhar(ctx: Ctx) -> None:
             up = hemisphere_bands(edges, up=True)
             rad = JK.of(r, "radiance")[0]
             f = (lambda mu, w0=w0, mu0=mu0: float(ref.chandrasekhar_radiance(w0, mu0, mu)))
-            band_ref = band_refs(edges, up, f)
-            ctx.compare_jk(f"{tag}: band-averaged reflected radiance L(mu)/Ed",
-                           rad.mean(axis=-1)[up], band_ref, labels=band_labels(edges, up),
-                           rel_cap=ctx.pick(0.01, 0.03))
-            q, ti, _, labels = quads(rad, edges, up, r.coords["phi"])
-            qref = band_ref[np.searchsorted(up, ti)]
-            ctx.compare_jk(f"{tag}: quad reflected radiance", q, qref, labels=labels,
-                           rel_cap=ctx.pick(0.04, 0.12),
-                           counts=expected_counts(qref, ti, edges, r.attrs["photons_per_batch"],
-                                                  len(r.coords["phi"])))
+            band_ref = compare_symmetric_radiance(
+                ctx, r, rad, edges, up, f, quad_cap=(0.04, 0.12),
+                band_check=f"{tag}: band-averaged reflected radiance L(mu)/Ed",
+                quad_check=f"{tag}: quad reflected radiance")
             if mu0 == 0.5:
                 curves[w0] = (edges, up, rad.mean(axis=-1), band_ref)
             # exact directions, local (next-event) estimate
