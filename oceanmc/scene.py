@@ -187,6 +187,17 @@ def _layer_cap_moments(sc: SceneArrays, layer: int, breaks: np.ndarray, geometry
     return _CAP_CACHE[key]
 
 
+def _upward_fields(estimator: cfg.Estimator, albedo: np.ndarray) -> dict:
+    """Scattering biased toward straight up (kernel/upward.py): a layer's fraction is at most
+    1 - w0, so that no scattering event makes a packet heavier; 0 in a layer leaves it out."""
+    fraction = np.minimum(float(estimator.upward_fraction or 0.0), 1.0 - albedo)
+    fraction[albedo <= 0.0] = 0.0
+    cos_cone = math.cos(math.radians(estimator.upward_cone_deg))
+    return dict(layer_up_fraction=fraction,
+                layer_up_density=fraction / (2.0 * math.pi * (1.0 - cos_cone)),
+                layer_up_keep=1.0 - fraction, up_cos=cos_cone)
+
+
 def _cap_fields(config: cfg.SceneConfig, sc: SceneArrays, grid: Grid) -> dict:
     """The nadir polar-cap local-estimate tables and constants (cap_tables.py)."""
     beta = math.radians(180.0 - grid.theta_edges[-2])
@@ -285,6 +296,8 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
 
     plane_z, plane_tally, segment_layer, surface_tally, depths = _planes(config)
     layer_c = np.array([layer.a + layer.b for layer in layers], dtype=np.float64)
+    albedo = np.array([layer.b / (layer.a + layer.b) if layer.b > 0.0 else 0.0
+                       for layer in layers], dtype=np.float64)
     plane_tau = _optical_depths(plane_z, segment_layer, layer_c)
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
                          dtype=np.float64)
@@ -302,8 +315,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         plane_z=plane_z, plane_tally=plane_tally, segment_layer=segment_layer,
         layer_c=layer_c,
         layer_inv_c=np.divide(1.0, layer_c, out=np.zeros_like(layer_c), where=layer_c > 0.0),
-        layer_albedo=np.array([layer.b / (layer.a + layer.b) if layer.b > 0.0 else 0.0
-                               for layer in layers], dtype=np.float64),
+        layer_albedo=albedo,
         layer_comp_start=np.array(comp_start, dtype=np.int64),
         layer_comp_count=np.array(comp_count, dtype=np.int64),
         comp_cumweight=np.array(cumweight, dtype=np.float64),
@@ -329,6 +341,7 @@ def build(config: cfg.SceneConfig) -> tuple[SceneArrays, Grid]:
         roulette_survival=float(config.estimator.roulette_survival),
         max_events=int(config.estimator.max_events),
         split_weight=float(config.estimator.split_weight or math.inf),
+        **_upward_fields(config.estimator, albedo),
         **{name: 0 for name in SceneArrays._fields if name.startswith("cap_")},
     )
     return sc._replace(**_cap_fields(config, sc, grid)), grid

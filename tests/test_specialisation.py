@@ -10,7 +10,7 @@ import oceanmc
 from oceanmc import scene
 from oceanmc.kernel.driver import features_of
 from oceanmc.kernel.models import (FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_RADIANCE,
-                                   FEATURE_SKY)
+                                   FEATURE_SKY, FEATURE_SPLITTING, FEATURE_UPWARD)
 
 BASE = {
     "photons": 20_000, "batches": 4, "seed": 5,
@@ -42,6 +42,8 @@ def config(**changes):
      FEATURE_RADIANCE | FEATURE_ESTIMATES),
     ({"tallies.radiance": False, "tallies.local_directions_deg": [[180.0, 0.0]]},
      FEATURE_ESTIMATES),
+    ({"estimator": {"split_weight": 2.0}}, FEATURE_RADIANCE | FEATURE_SPLITTING),
+    ({"estimator": {"upward_fraction": 0.1}}, FEATURE_RADIANCE | FEATURE_UPWARD),
 ])
 def test_features_follow_the_scene(changes, expected):
     sc, _ = scene.build(config(**changes))

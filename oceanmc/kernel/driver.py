@@ -13,7 +13,7 @@ from numba import literally, njit, prange, typeof
 from numba.core import types
 
 from .models import (BOTTOM_BLACK, BOTTOM_NONE, FEATURE_BOTTOM, FEATURE_ESTIMATES,
-                     FEATURE_RADIANCE, FEATURE_SKY, FEATURE_SPLITTING)
+                     FEATURE_RADIANCE, FEATURE_SKY, FEATURE_SPLITTING, FEATURE_UPWARD)
 from .transport import trace_batch
 
 
@@ -30,6 +30,8 @@ def features_of(sc) -> int:
         features |= FEATURE_ESTIMATES
     if sc.split_weight < math.inf:
         features |= FEATURE_SPLITTING
+    if sc.layer_up_fraction.max(initial=0.0) > 0.0:
+        features |= FEATURE_UPWARD
     return features
 
 

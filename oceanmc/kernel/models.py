@@ -41,6 +41,7 @@ FEATURE_BOTTOM = 2       # a reflecting bottom (not none or black)
 FEATURE_RADIANCE = 4     # the radiance quad tallies
 FEATURE_ESTIMATES = 8    # local estimates: exact directions and/or the nadir polar cap
 FEATURE_SPLITTING = 16   # splitting of packets heavier than estimator.split_weight
+FEATURE_UPWARD = 32      # scattering biased toward straight up (estimator.upward_fraction)
 
 # Packets waiting after a split (transport.split): one row per packet, its start state.
 SPLIT_STACK_ROWS = 64

@@ -34,6 +34,9 @@ SceneArrays = namedtuple("SceneArrays", [
     "cap_h", "cap_dh",
     # estimator
     "analog", "roulette_weight", "roulette_survival", "max_events", "split_weight",
+    # scattering biased toward straight up (kernel/upward.py): per layer the fraction f of
+    # events that draw from the cone, f / (the cone's solid angle) and 1 - f; cos(half-angle)
+    "layer_up_fraction", "layer_up_density", "layer_up_keep", "up_cos",
     # tabulated skies (sky_maps.py): cell edges in sin^2(theta_view) and phi_view (rad), the
     # marginal CDF over rows, conditional CDFs within rows, cell radiances, sky parameters
     "sky_s_edges", "sky_phi_edges", "sky_row_cdf", "sky_cell_cdf", "sky_cell_L", "sky_params",

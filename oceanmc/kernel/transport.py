@@ -6,7 +6,8 @@ multiplies its weight by the single-scattering albedo), expected values at the s
 from the air: the reflected part w R is scored and the packet enters with w (1 - R); light from
 the water: the leaving part w (1 - R) is scored, and the packet goes on, reflected, with
 probability R and weight w), weight times rho_dh at the bottom, exact exponential attenuation in layers that do not scatter, and unbiased Russian
-roulette below sc.roulette_weight. Analog mode decides each of these with a random draw instead.
+roulette below sc.roulette_weight; optionally, scattering biased toward straight up (upward.py)
+and splitting of heavy packets. Analog mode decides each of these with a random draw instead.
 Either way every quantity has the same expectation; only the variance differs.
 
 Every function that takes the scene (one large named tuple) is compiled with inline="always":
@@ -31,15 +32,15 @@ import math
 import numpy as np
 from numba import njit
 
-from . import local_estimate
+from . import local_estimate, upward
 from .brdf import dispatch as brdf
 from .geometry import from_angles, turn
 from .interface import reflectance, refract
 from .models import (BOTTOM_SPECULAR, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING,
                      FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_SKY, FEATURE_SPLITTING,
-                     STACK_BEAM, STACK_SEGMENT, STACK_UX, STACK_UY, STACK_UZ, STACK_WEIGHT,
-                     STACK_Z)
+                     FEATURE_UPWARD, STACK_BEAM, STACK_SEGMENT, STACK_UX, STACK_UY, STACK_UZ,
+                     STACK_WEIGHT, STACK_Z)
 from .phase import dispatch as phase
 from .sources import sky_direction
 from .tally import score, score_air_up
@@ -155,9 +156,12 @@ def trace_in_water(sc, features, z, seg, w, ux, uy, uz, beam, flux, radiance, lo
                     scattered = w * albedo
                     budget[BUDGET_LAYERS + layer] += w - scattered
                     w = scattered
-                u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
-                cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
-                ux, uy, uz = turn(ux, uy, uz, cos_s, np.random.random())
+                if features & FEATURE_UPWARD:
+                    w, ux, uy, uz = upward.scatter(sc, layer, w, ux, uy, uz)
+                else:
+                    u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
+                    cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
+                    ux, uy, uz = turn(ux, uy, uz, cos_s, np.random.random())
                 beam = False
                 tau = exponential()
                 alive, w = survives_roulette(sc, w)
