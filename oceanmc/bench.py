@@ -76,6 +76,8 @@ def without_exact_directions(config):
 
 CROSSING_ONLY = ", crossing estimator only"
 NO_ROULETTE = ", roulette at weight 1e-12"
+UPWARD_FRACTION = 0.1
+UPWARD = f", upward-biased scattering (fraction {UPWARD_FRACTION:g})"
 # batches per error-vs-time run: the batch standard error, and so the FOM, to about 6% and 12%
 FOM_BATCHES = 128
 
@@ -114,7 +116,23 @@ def scenes(configs_dir: Path) -> list[dict]:
          "quantities": [Quantity("Rrs nadir (local)", "air/Rrs_nadir"),
                         Quantity("Lu(10 m) (local)", "Lu", (2,)),
                         Quantity("Ed(10 m)", "Ed", (2,))]},
+        # scattering biased toward straight up: the same expectations, so the plain scene's
+        # long run is its reference
+        {"name": f"clear ocean{UPWARD}", "reference": "clear ocean",
+         "config": with_photons(clear, clear.photons,
+                                **{"estimator.upward_fraction": UPWARD_FRACTION}),
+         "quantities": [Quantity("Rrs nadir (local)", "air/Rrs_nadir"),
+                        Quantity("Rrs nadir (crossing)", "air/Rrs_nadir_crossing"),
+                        Quantity("Lu(10 m) (local)", "Lu", (2,)),
+                        Quantity("Lu(10 m) (crossing)", "Lu_crossing", (2,)),
+                        Quantity("Ed(10 m)", "Ed", (2,))]},
         {"name": "shallow sand", "config": shallow, "reference": None,
+         "quantities": [Quantity("Rrs nadir (local)", "air/Rrs_nadir"),
+                        Quantity("Rrs nadir (crossing)", "air/Rrs_nadir_crossing"),
+                        Quantity("Eu(0-)", "Eu", (0,))]},
+        {"name": f"shallow sand{UPWARD}", "reference": "shallow sand",
+         "config": with_photons(shallow, shallow.photons,
+                                **{"estimator.upward_fraction": UPWARD_FRACTION}),
          "quantities": [Quantity("Rrs nadir (local)", "air/Rrs_nadir"),
                         Quantity("Rrs nadir (crossing)", "air/Rrs_nadir_crossing"),
                         Quantity("Eu(0-)", "Eu", (0,))]},
@@ -235,15 +253,24 @@ FEATURES: list[tuple[str, dict]] = [
                                        "tallies.local_directions_deg": [[180.0, 0.0]]}),
     ("+ sky (20% uniform)", {"illumination.diffuse_fraction": 0.2}),
     ("+ Lambertian bottom (0.3)", {"bottom": {"model": "lambertian", "reflectance": 0.3}}),
+    (f"+ upward-biased scattering (fraction {UPWARD_FRACTION:g}; shorter histories)",
+     {"estimator.upward_fraction": UPWARD_FRACTION}),
     ("no surface (index-matched)", {"surface.model": "none"}),
     ("analog estimator", {"estimator.mode": "analog"}),
 ]
 
 
-def feature_costs(configs_dir: Path, photons: int, repeats: int) -> list[dict]:
+# the --quick smoke test measures only these (each other row compiles a loop of its own)
+QUICK_FEATURES = ("no tallies at all", "+ local nadir-cap estimate")
+
+
+def feature_costs(configs_dir: Path, photons: int, repeats: int, quick: bool = False
+                  ) -> list[dict]:
     config = load_config(configs_dir / "bare_walk.yaml")
     rows = []
     for label, changes in FEATURES:
+        if quick and label not in QUICK_FEATURES:
+            continue
         scene = with_photons(config, photons, **changes)
         speeds = oceanmc_runs(scene, photons, 1, repeats)
         rows.append({"variant": label, "photons_per_s_1t": statistics.median(speeds)})
@@ -421,6 +448,14 @@ def write_report(out_dir: Path, data: dict) -> None:
                   "at weight 1e-12 (packets followed until they leave or underflow):", ""]
         for key, value in roulette.items():
             lines.append(f"- {key}: {value:.2f}x")
+    upward = data.get("upward_ratios", {})
+    if upward:
+        lines += ["", "Scattering biased toward straight up (`estimator.upward_fraction: "
+                  f"{UPWARD_FRACTION:g}`, cone 15 deg; the fraction is at most 1 - w0 per "
+                  "layer) over the same scene without it, and its local estimates over plain "
+                  "photon counting:", ""]
+        for key, value in upward.items():
+            lines.append(f"- {key}: {value:.2f}x")
     spot = data.get("sky_sampling")
     if spot:
         lines += ["", f"## Sky sampling: {SKY_SPOT}", "",
@@ -466,13 +501,35 @@ def fom_ratios(foms: list[dict]) -> dict[str, float]:
     return out
 
 
+def variant_ratios(foms: list[dict], suffix: str) -> dict[str, float]:
+    """FOM of each quantity of a scene run with a variant (the scene's name + suffix) over the
+    FOM of the same quantity in the scene itself."""
+    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    return {f"{scene}, {label}": value / table[(scene, label)]
+            for (name, label), value in table.items() if name.endswith(suffix)
+            for scene in [name[:-len(suffix)]] if (scene, label) in table}
+
+
 def roulette_ratios(foms: list[dict]) -> dict[str, float]:
     """FOM with the default roulette (weight 1e-3, survival 0.1) over the FOM with roulette
     pushed out of reach, per quantity of the scene that has both runs."""
+    return {key: 1.0 / value for key, value in variant_ratios(foms, NO_ROULETTE).items()}
+
+
+def upward_ratios(foms: list[dict]) -> dict[str, float]:
+    """FOM with scattering biased toward straight up over the FOM without, per quantity; and
+    for the local estimates with the bias, over plain photon counting (the crossing-only run)."""
+    out = {f"{key}, biased over plain": value
+           for key, value in variant_ratios(foms, UPWARD).items()}
     table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
-    return {f"{scene}, {label}": table[(scene, label)] / value
-            for (name, label), value in table.items() if name.endswith(NO_ROULETTE)
-            for scene in [name[:-len(NO_ROULETTE)]] if (scene, label) in table}
+    for (name, label), value in table.items():
+        if name.endswith(UPWARD) and label.endswith("(local)"):
+            scene = name[:-len(UPWARD)]
+            alone = table.get((scene + CROSSING_ONLY, label.replace("(local)", "(crossing)")))
+            if alone:
+                out[f"{scene}, {label.replace(' (local)', '')}: local estimate with upward-"
+                    "biased scattering over a crossing-only run"] = value / alone
+    return out
 
 
 def sampling_ratios(foms: list[dict]) -> list[dict]:
@@ -511,7 +568,7 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
             "numba": numba.__version__, "quick": quick}
     data["speed_ceiling"] = speed_ceiling(configs_dir, bare_walk, photons, repeats)
     say("feature costs ...")
-    data["features"] = feature_costs(configs_dir, photons, repeats)
+    data["features"] = feature_costs(configs_dir, photons, repeats, quick)
     say("start-up ...")
     data["startup"] = startup_times(cold=not quick)
     data["error_vs_time"] = []
@@ -538,6 +595,7 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
     data["fom"] = fom_summary(data["error_vs_time"])
     data["fom_ratios"] = fom_ratios(data["fom"])
     data["roulette_ratios"] = roulette_ratios(data["fom"])
+    data["upward_ratios"] = upward_ratios(data["fom"])
     data["sky_sampling"] = sampling_ratios(data["fom"])
     write_report(out_dir, data)
     say(f"wrote {out_dir / 'bench.md'}")

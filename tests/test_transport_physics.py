@@ -474,10 +474,12 @@ def test_water_to_air_reflectance():
 
 # --- 8. Chandrasekhar: semi-infinite isotropic scattering --------------------------------------
 
-def test_chandrasekhar_semi_infinite():
+@pytest.mark.parametrize("upward_fraction", [None, 0.1])
+def test_chandrasekhar_semi_infinite(upward_fraction):
     """w0 = 0.8, mu0 = 0.5, no interface: plane albedo A = 1 - H(mu0) sqrt(1 - w0) = 0.36797 and
     reflected radiance L(mu)/Ed = w0 H(mu) H(mu0) / (4 pi (mu + mu0)) (0.09586 at nadir), here
-    compared as quad averages over every upward band, the 175-180 deg cap included."""
+    compared as quad averages over every upward band, the 175-180 deg cap included; with the
+    plain walk and with scattering biased toward straight up (estimator.upward_fraction)."""
     w0, mu0 = 0.8, 0.5
     H = chandrasekhar_h(w0)
     A = 1.0 - H(mu0)[0] * math.sqrt(1.0 - w0)
@@ -489,7 +491,8 @@ def test_chandrasekhar_semi_infinite():
                   "surface": {"model": "none"},
                   "water": {"layers": [{"thickness_m": float("inf"), "a": 0.2, "b": 0.8,
                                         "phase": {"model": "isotropic"}}]},
-                  "bottom": {"model": "none"}, "tallies": {"depths_m": [0.0]}})
+                  "bottom": {"model": "none"}, "tallies": {"depths_m": [0.0]},
+                  "estimator": {"upward_fraction": upward_fraction}})
     za = zr(r, r["air/Eu"], A, r.stderr("air/Eu"), rel_max=0.003, what="plane albedo")
     assert r["Ed"][0] == pytest.approx(1.0, rel=1e-12)
     assert r["Eu"][0] == pytest.approx(r["air/Eu"], rel=1e-12)
