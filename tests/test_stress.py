@@ -18,13 +18,16 @@ def run(scene, photons=20_000, batches=8, seed=3):
     return r
 
 
-def test_nearly_conservative_deep_slab():
+@pytest.mark.parametrize("upward_fraction", [None, 0.5])
+def test_nearly_conservative_deep_slab(upward_fraction):
     """w0 = 1 - 1e-9 over optical depth 50: thousands of scatterings per photon; everything
-    that is not absorbed (a fraction ~1e-9 x events) is reflected or transmitted."""
+    that is not absorbed (a fraction ~1e-9 x events) is reflected or transmitted. With
+    upward-biased scattering the fraction is capped at 1 - w0 = 1e-9: no weight grows."""
     r = run({"illumination": {"sun_zenith_deg": 30},
              "water": {"layers": [{"thickness_m": 50.0, "a": 1e-9, "b": 1.0,
                                    "phase": {"model": "isotropic"}}]},
-             "bottom": {"model": "black"}, "tallies": {"depths_m": [0, 25, 50]}},
+             "bottom": {"model": "black"}, "tallies": {"depths_m": [0, 25, 50]},
+             "estimator": {"upward_fraction": upward_fraction}},
             photons=2000, batches=4)
     assert r["budget/absorbed_layer_1"] < 1e-4
     assert r.attrs["scattering_events"] / r.attrs["photons"] > 100

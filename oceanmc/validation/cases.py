@@ -727,6 +727,86 @@ DISORT_LOCAL = ((180.0, 0.0), (160.0, 0.0), (140.0, 0.0), (140.0, 90.0), (140.0,
                 (120.0, 0.0), (120.0, 180.0), (100.0, 45.0))
 
 
+def _disort_slab(ctx: Ctx, slab: tuple, photons: int, estimator: dict | None = None,
+                 tag: str = "") -> tuple[str, tuple]:
+    """One HG slab of DISORT_SLABS against DISORT: fluxes, every distinct quad, and the local
+    estimates in exact directions; returns (name, what the principal-plane figure needs)."""
+    from . import disort_ref
+    tau, w0, g, sun, rho = slab
+    thickness = 2.0
+    c = tau / thickness
+    bottom = {"model": "lambertian", "reflectance": rho} if rho > 0 else {"model": "black"}
+    levels_z = [0.0, thickness / 2, thickness]
+    name = f"tau {tau:g}, w0 {w0:g}, g {g:g}, sun {sun:g}, " + \
+        (f"Lambertian {rho:g}" if rho > 0 else "black") + " bottom" + tag
+    cfg = scene(name, photons, sun=sun, surface="none",
+                layers=[{"thickness_m": thickness, "a": (1 - w0) * c, "b": w0 * c,
+                         "phase": {"model": "henyey_greenstein", "g": g}}],
+                bottom=bottom, depths=levels_z)
+    cfg["tallies"]["local_directions_deg"] = [list(d) for d in DISORT_LOCAL]
+    if estimator:
+        cfg["estimator"] = dict(estimator)
+    r = ctx.simulate(cfg)
+    edges = edges_of(r)
+    phi_edges = np.asarray(r.coords["phi_edges"])
+    is_cap = np.zeros(len(edges) - 1, bool)
+    is_cap[[0, -1]] = True
+    taus = [tau * z / thickness for z in levels_z]
+    with disort_ref.single_blas_thread():
+        d1 = disort_ref.slab(tau, w0, g, sun, rho, taus, edges, phi_edges, is_cap, MU_CUT,
+                             nquad=128)
+        d2 = disort_ref.slab(tau, w0, g, sun, rho, taus, edges, phi_edges, is_cap, MU_CUT,
+                             nquad=96, n_mu=14, n_phi=12)
+    ctx.exact(f"{name}: DISORT Ed(top) = 1 (I0 = 1/mu0, direct beam included)",
+              d1["Ed"][0], 1.0, rtol=1e-9)
+    if rho > 0:
+        ctx.exact(f"{name}: DISORT Eu(bottom) = rho Ed(bottom) (BDRF mode [rho])",
+                  d1["Eu"][2], rho * d1["Ed"][2], rtol=1e-6)
+    ed = JK.of(r, "Ed")
+    eu = JK.of(r, "Eu")
+    err_ed = np.abs(d1["Ed"] - d2["Ed"])
+    err_eu = np.abs(d1["Eu"] - d2["Eu"])
+    sel_ed = [1, 2]
+    sel_eu = [0, 1, 2] if rho > 0 else [0, 1]
+    lab = ["top", "middle", "bottom"]
+    ctx.compare_jk(f"{name}: Ed", ed[sel_ed], d1["Ed"][sel_ed],
+                   ref_error=err_ed[sel_ed], labels=[lab[i] for i in sel_ed],
+                   rel_cap=ctx.pick(0.01, 0.03))
+    ctx.compare_jk(f"{name}: Eu", eu[sel_eu], d1["Eu"][sel_eu],
+                   ref_error=err_eu[sel_eu], labels=[lab[i] for i in sel_eu],
+                   rel_cap=ctx.pick(0.01, 0.03))
+    rad = JK.of(r, "radiance")
+    rerr = np.abs(d1["radiance"] - d2["radiance"])
+    up = hemisphere_bands(edges, up=True)
+    down = hemisphere_bands(edges, up=False)
+    groups = [(0, up, "top, upward"), (1, down, "middle, downward"),
+              (1, up, "middle, upward"), (2, down, "bottom, downward")]
+    if rho > 0:
+        groups.append((2, up, "bottom, upward"))
+    for lev, bands, where in groups:
+        q, idx_t, idx_p, labels = quads(rad[lev], edges, bands, r.coords["phi"])
+        qref = d1["radiance"][lev][idx_t, idx_p]
+        ctx.compare(f"{name}: quad radiance, {where}", q.value, q.stderr, qref,
+                    ref_error=rerr[lev][idx_t, idx_p], labels=labels, loo=q.loo,
+                    n_batches=q.n, rel_cap=ctx.pick(0.04, 0.12),
+                    counts=expected_counts(qref, idx_t, edges,
+                                           r.attrs["photons_per_batch"], len(phi_edges) - 1))
+    # exact upward directions (local estimate) against DISORT's intensity at the same points
+    mus = np.array([math.cos(math.radians(t)) for t, _ in DISORT_LOCAL])  # of travel
+    phis = np.radians([p for _, p in DISORT_LOCAL])
+    with disort_ref.single_blas_thread():
+        p1 = disort_ref.point_radiance(tau, w0, g, sun, rho, taus, mus, phis, nquad=128)
+        p2 = disort_ref.point_radiance(tau, w0, g, sun, rho, taus, mus, phis, nquad=96)
+    loc = JK.of(r, "local_radiance")
+    lev_sel = [0, 1, 2] if rho > 0 else [0, 1]
+    for lev in lev_sel:
+        ctx.compare_jk(f"{name}: radiance in exact directions, {lab[lev]} (local estimate)",
+                       loc[lev], p1[lev], ref_error=np.abs(p1[lev] - p2[lev]),
+                       labels=[f"theta {t:g} phi {p:g}" for t, p in DISORT_LOCAL],
+                       rel_cap=ctx.pick(0.02, 0.06))
+    return name, (edges, np.asarray(r.coords["phi"]), rad, d1)
+
+
 def case_disort(ctx: Ctx) -> None:
     from . import disort_ref
     with disort_ref.single_blas_thread():
@@ -734,79 +814,8 @@ def case_disort(ctx: Ctx) -> None:
     ctx.exact(f"convention: DISORT downward radiance of a thin forward-scattering slab at "
               f"phi = phi0, {peak:.4g}, exceeds that at phi0 + pi, {back:.4g}, tenfold (phi is the "
               f"travel azimuth)", float(peak / back > 10.0), 1.0)
-    thickness = 2.0
     photons = ctx.pick(6_000_000, 200_000)
-    ppp = {}
-    for (tau, w0, g, sun, rho) in DISORT_SLABS:
-        c = tau / thickness
-        bottom = {"model": "lambertian", "reflectance": rho} if rho > 0 else {"model": "black"}
-        levels_z = [0.0, thickness / 2, thickness]
-        name = f"tau {tau:g}, w0 {w0:g}, g {g:g}, sun {sun:g}, " + \
-            (f"Lambertian {rho:g}" if rho > 0 else "black") + " bottom"
-        cfg = scene(name, photons, sun=sun, surface="none",
-                    layers=[{"thickness_m": thickness, "a": (1 - w0) * c, "b": w0 * c,
-                             "phase": {"model": "henyey_greenstein", "g": g}}],
-                    bottom=bottom, depths=levels_z)
-        cfg["tallies"]["local_directions_deg"] = [list(d) for d in DISORT_LOCAL]
-        r = ctx.simulate(cfg)
-        edges = edges_of(r)
-        phi_edges = np.asarray(r.coords["phi_edges"])
-        is_cap = np.zeros(len(edges) - 1, bool)
-        is_cap[[0, -1]] = True
-        taus = [tau * z / thickness for z in levels_z]
-        with disort_ref.single_blas_thread():
-            d1 = disort_ref.slab(tau, w0, g, sun, rho, taus, edges, phi_edges, is_cap, MU_CUT,
-                                 nquad=128)
-            d2 = disort_ref.slab(tau, w0, g, sun, rho, taus, edges, phi_edges, is_cap, MU_CUT,
-                                 nquad=96, n_mu=14, n_phi=12)
-        ctx.exact(f"{name}: DISORT Ed(top) = 1 (I0 = 1/mu0, direct beam included)",
-                  d1["Ed"][0], 1.0, rtol=1e-9)
-        if rho > 0:
-            ctx.exact(f"{name}: DISORT Eu(bottom) = rho Ed(bottom) (BDRF mode [rho])",
-                      d1["Eu"][2], rho * d1["Ed"][2], rtol=1e-6)
-        ed = JK.of(r, "Ed")
-        eu = JK.of(r, "Eu")
-        err_ed = np.abs(d1["Ed"] - d2["Ed"])
-        err_eu = np.abs(d1["Eu"] - d2["Eu"])
-        sel_ed = [1, 2]
-        sel_eu = [0, 1, 2] if rho > 0 else [0, 1]
-        lab = ["top", "middle", "bottom"]
-        ctx.compare_jk(f"{name}: Ed", ed[sel_ed], d1["Ed"][sel_ed],
-                       ref_error=err_ed[sel_ed], labels=[lab[i] for i in sel_ed],
-                       rel_cap=ctx.pick(0.01, 0.03))
-        ctx.compare_jk(f"{name}: Eu", eu[sel_eu], d1["Eu"][sel_eu],
-                       ref_error=err_eu[sel_eu], labels=[lab[i] for i in sel_eu],
-                       rel_cap=ctx.pick(0.01, 0.03))
-        rad = JK.of(r, "radiance")
-        rerr = np.abs(d1["radiance"] - d2["radiance"])
-        up = hemisphere_bands(edges, up=True)
-        down = hemisphere_bands(edges, up=False)
-        groups = [(0, up, "top, upward"), (1, down, "middle, downward"),
-                  (1, up, "middle, upward"), (2, down, "bottom, downward")]
-        if rho > 0:
-            groups.append((2, up, "bottom, upward"))
-        for lev, bands, where in groups:
-            q, idx_t, idx_p, labels = quads(rad[lev], edges, bands, r.coords["phi"])
-            qref = d1["radiance"][lev][idx_t, idx_p]
-            ctx.compare(f"{name}: quad radiance, {where}", q.value, q.stderr, qref,
-                        ref_error=rerr[lev][idx_t, idx_p], labels=labels, loo=q.loo,
-                        n_batches=q.n, rel_cap=ctx.pick(0.04, 0.12),
-                        counts=expected_counts(qref, idx_t, edges,
-                                               r.attrs["photons_per_batch"], len(phi_edges) - 1))
-        # exact upward directions (local estimate) against DISORT's intensity at the same points
-        mus = np.array([math.cos(math.radians(t)) for t, _ in DISORT_LOCAL])  # of travel
-        phis = np.radians([p for _, p in DISORT_LOCAL])
-        with disort_ref.single_blas_thread():
-            p1 = disort_ref.point_radiance(tau, w0, g, sun, rho, taus, mus, phis, nquad=128)
-            p2 = disort_ref.point_radiance(tau, w0, g, sun, rho, taus, mus, phis, nquad=96)
-        loc = JK.of(r, "local_radiance")
-        lev_sel = [0, 1, 2] if rho > 0 else [0, 1]
-        for lev in lev_sel:
-            ctx.compare_jk(f"{name}: radiance in exact directions, {lab[lev]} (local estimate)",
-                           loc[lev], p1[lev], ref_error=np.abs(p1[lev] - p2[lev]),
-                           labels=[f"theta {t:g} phi {p:g}" for t, p in DISORT_LOCAL],
-                           rel_cap=ctx.pick(0.02, 0.06))
-        ppp[name] = (edges, np.asarray(r.coords["phi"]), rad, d1)
+    ppp = dict(_disort_slab(ctx, slab, photons) for slab in DISORT_SLABS)
 
     plt = _plt()
     fig, axes = plt.subplots(len(ppp), 2, figsize=(11, 3.0 * len(ppp)), squeeze=False)
@@ -849,6 +858,26 @@ def case_disort(ctx: Ctx) -> None:
              " at each level are compared with DISORT's intensity at the same points.\n\n"
              "DISORT conventions adopted (PythonicDISORT -> oceanmc):\n\n" +
              "\n".join("- " + line.strip() for line in _disort_conventions()))
+
+
+# --- 6b. Scattering biased toward straight up ------------------------------------------------------
+
+UPWARD_FRACTION = 0.1
+UPWARD_SLABS = [DISORT_SLABS[0], DISORT_SLABS[2], DISORT_SLABS[3]]
+
+
+def case_upward_bias(ctx: Ctx) -> None:
+    photons = ctx.pick(6_000_000, 200_000)
+    for slab in UPWARD_SLABS:
+        _disort_slab(ctx, slab, photons, {"upward_fraction": UPWARD_FRACTION},
+                     tag=", upward-biased scattering")
+    ctx.note(f"The DISORT slabs {', '.join(f'tau {s[0]:g}, w0 {s[1]:g}, g {s[2]:g}' for s in UPWARD_SLABS)} "
+             f"run with `estimator.upward_fraction: {UPWARD_FRACTION:g}` (cone 15 deg): a "
+             "fraction min(0.1, 1 - w0) of scattering events draws its new direction uniformly "
+             "in the cone around straight up and the packet carries the defensive-mixture "
+             "weight p / ((1 - f) p + f g) (kernel/upward.py). The weights change, the "
+             "expectations must not: the same checks as the disort case, against the same "
+             "DISORT references (fluxes, every distinct quad, exact-direction local estimates).")
 
 
 def _disort_conventions() -> list[str]:
@@ -1016,6 +1045,9 @@ CASES = [
          case_chandrasekhar, "plane albedo and reflected radiance"),
     Case("disort", "Slabs against DISORT (PythonicDISORT)", case_disort,
          "fluxes and quad radiances of HG slabs"),
+    Case("upward_bias", "Scattering biased toward straight up, against DISORT",
+         case_upward_bias, "DISORT slabs rerun with estimator.upward_fraction 0.1: fluxes, "
+         "quad radiances, exact-direction local estimates"),
     Case("white_furnace", "White furnace: energy conservation", case_white_furnace,
          "water-leaving + surface reflection = 1"),
     Case("reciprocity", "Reciprocity of the reflection function", case_reciprocity,
