@@ -159,10 +159,21 @@ class SkyMap(_Strict):
     proportion to L cos dOmega (every sky photon has the same weight); cosine draws them
     cosine-weighted over the hemisphere whatever L, each photon weighted by L(its cell) pi / E
     with E the integral of L cos dOmega: the same expectation, far more noise for a peaked map
-    (for comparisons)."""
+    (for comparisons). layout (.exr only): what the image's rows cover: sphere (theta_view
+    0..180 deg; the upper half is read), hemisphere (0..90 deg), or auto: sphere exactly when
+    the image is twice as wide as it is high."""
     map: str
     dataset: str = "radiance"
     sampling: Literal["importance", "cosine"] = "importance"
+    layout: Literal["auto", "hemisphere", "sphere"] = "auto"
+
+    @model_validator(mode="after")
+    def _layout_is_for_images(self) -> "SkyMap":
+        if self.layout != "auto" and not self.map.lower().endswith(".exr"):
+            raise ValueError(f"layout = {self.layout!r} with map = {self.map!r}: layout applies "
+                             "to .exr images; a .npy, .npz or HDF5 map covers theta_view "
+                             "0..90 deg (or its own theta_edges_deg); leave layout out")
+        return self
 
 
 class Illumination(_Strict):

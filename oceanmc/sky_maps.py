@@ -22,12 +22,12 @@ theta_view and azimuth phi_view, on an equirectangular grid of cells, each of co
     (n_phi + 1, strictly increasing, spanning exactly 360 deg);
   - OpenEXR (.exr), read with the OpenEXR package: a single-part scanline or tiled image whose
     pixel rows are theta_view rows and columns phi_view columns, in equal steps, as for .npy
-    (image row 0, the top, at the zenith; column 0, the left, starting at phi_view = 0). An image
-    exactly twice as wide as it is high is a full-sphere equirectangular panorama (the common
-    HDRI layout: rows cover theta_view 0..180 deg) and only its upper half (rows 0..height/2 - 1,
-    the sky) is used; its height must then be even. Any other shape is the upper hemisphere
-    alone (rows 0..90 deg). So a hemisphere map must not be twice as wide as it is high (use,
-    e.g., 90 x 360 rather than 90 x 180 cells, or a .npy file). The radiance is the channel
+    (image row 0, the top, at the zenith; column 0, the left, starting at phi_view = 0). The key
+    `layout` says what the rows cover: `sphere`, a full-sphere equirectangular panorama (the
+    common HDRI layout: rows cover theta_view 0..180 deg), of which only the upper half (rows
+    0..height/2 - 1, the sky) is used, so its height must be even; `hemisphere`, the upper
+    hemisphere alone (rows 0..90 deg); `auto` (the default), sphere for an image exactly twice
+    as wide as it is high and hemisphere for any other shape. The radiance is the channel
     named `dataset` if the image has one; otherwise, with the default `dataset` (radiance), the
     channel Y if present, else the luminance of the linear R, G, B channels with the Rec. 709 /
     sRGB primaries and D65 white, Y = 0.2126 R + 0.7152 G + 0.0722 B (ITU-R BT.709-6, item 3.2;
@@ -140,10 +140,10 @@ def _pixels(path, channels: dict, name: str, shape: tuple[int, int], rows: int) 
     return px
 
 
-def _read_exr(path, dataset: str) -> np.ndarray:
+def _read_exr(path, dataset: str, layout: str) -> np.ndarray:
     """The radiance (n_theta, n_phi) of an equirectangular OpenEXR sky image (module docstring):
     the channel `dataset`, else Y, else the Rec. 709 luminance of R, G, B; the upper half of a
-    full-sphere image (width = 2 height)."""
+    full-sphere image (layout sphere, or auto with width = 2 height)."""
     try:
         import OpenEXR
     except ImportError as exc:
@@ -166,11 +166,12 @@ def _read_exr(path, dataset: str) -> np.ndarray:
     part = f.parts[0]
     shape = (int(part.height()), int(part.width()))
     rows = shape[0]
-    if 2 * shape[0] == shape[1]:              # full sphere, rows 0..180 deg: keep the sky
+    if layout == "sphere" or (layout == "auto" and 2 * shape[0] == shape[1]):
+        # full sphere, rows 0..180 deg: keep the sky
         if shape[0] % 2:
-            _fail(path, f"a full-sphere image ({shape[0]} x {shape[1]} pixels, width = 2 x "
-                        f"height) needs an even height, so that the horizon falls between two "
-                        f"rows")
+            _fail(path, f"a full-sphere image ({shape[0]} x {shape[1]} pixels, layout "
+                        f"{layout}) needs an even height, so that the horizon falls between "
+                        f"two rows")
         rows = shape[0] // 2
     names = sorted(channels)
     if dataset in channels:
@@ -219,9 +220,10 @@ def _edges(path, data: dict, name: str, n: int, span: tuple[float, float] | None
     return e
 
 
-def read_sky_map(path, dataset: str = "radiance") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(theta_edges_deg, phi_edges_deg, radiance (n_theta, n_phi)) of a sky map file, checked;
-    every problem is a TableError naming the file."""
+    every problem is a TableError naming the file. layout: what an .exr image's rows cover."""
     path = Path(str(path))
     if not path.is_file():
         _fail(path, "no such file")
@@ -249,7 +251,7 @@ def read_sky_map(path, dataset: str = "radiance") -> tuple[np.ndarray, np.ndarra
         except (OSError, ValueError, TypeError) as exc:
             _fail(path, f"cannot read it as HDF5 ({exc})")
     elif suffix == ".exr":
-        data[dataset] = _read_exr(path, dataset)
+        data[dataset] = _read_exr(path, dataset, layout)
     else:
         _fail(path, f"unknown file type {suffix!r}; use .npy, .npz, .h5/.hdf5 or .exr")
     if dataset not in data:
@@ -336,7 +338,7 @@ def sky_fields(ill: cfg.Illumination) -> dict:
         theta, phi, L = harrison_coombes_cells(ill.sun_zenith_deg)
         model = models.SKY_HARRISON_COOMBES
     else:
-        theta, phi, L = read_sky_map(sky.map, sky.dataset)
+        theta, phi, L = read_sky_map(sky.map, sky.dataset, sky.layout)
         model = models.SKY_MAP if sky.sampling == "importance" else models.SKY_MAP_COSINE
     tables = sampling_tables(theta, phi, L)
     if model == models.SKY_MAP_COSINE:

@@ -421,6 +421,10 @@ def test_bad_sky_files(tmp_path):
         assert "sky map" in msg and str(tmp_path / name) in msg and words in msg, (name, msg)
     # another dataset name
     scene.build(load_config(base({"map": str(tmp_path / "other.npz"), "dataset": "sky"})))
+    # layout is for .exr images only
+    msg = sky_error(tmp_path / "neg.npy", layout="sphere")
+    assert "illumination.sky" in msg and "layout = 'sphere'" in msg and \
+        "applies to .exr images" in msg and "\n" not in msg, msg
 
 
 def test_sky_config(tmp_path):
@@ -520,6 +524,18 @@ def test_exr_map_reading(tmp_path):
         theta, phi, Lh = sky_maps.read_sky_map(write_exr(tmp_path / "h.exr", {"Y": img}))
         np.testing.assert_array_equal(Lh, img.astype(np.float64))
         assert theta.size == shape[0] + 1 and phi.size == shape[1] + 1
+    # layout says it outright: a 2:1 hemisphere map (8 x 16) read whole, rows 0..90 deg; a
+    # full sphere that is not 2:1 (8 x 15) read in its upper half, rows 0..90 deg of 0..180
+    img = np.random.default_rng(2).uniform(0.5, 2.0, (8, 16)).astype(np.float32)
+    theta, _, Lh = sky_maps.read_sky_map(write_exr(tmp_path / "h2.exr", {"Y": img}),
+                                         layout="hemisphere")
+    np.testing.assert_array_equal(Lh, img.astype(np.float64))
+    np.testing.assert_allclose(theta, np.linspace(0.0, 90.0, 9))
+    img = np.random.default_rng(3).uniform(0.5, 2.0, (8, 15)).astype(np.float32)
+    theta, _, Ls = sky_maps.read_sky_map(write_exr(tmp_path / "s2.exr", {"Y": img}),
+                                         layout="sphere")
+    np.testing.assert_array_equal(Ls, img[:4].astype(np.float64))
+    np.testing.assert_allclose(theta, np.linspace(0.0, 90.0, 5))
 
 
 def assert_same_fields(a, b):
@@ -596,6 +612,9 @@ def test_bad_exr_files(tmp_path):
         assert "\n" not in msg, (name, msg)
     msg = sky_error(tmp_path / "good.exr", dataset="radiance.Y")
     assert "no channel 'radiance.Y' (found: ['Y'])" in msg, msg
+    # a sphere layout needs an even height whatever the shape
+    msg = sky_error(tmp_path / "neg.exr", layout="sphere")
+    assert "(5 x 8 pixels, layout sphere) needs an even height" in msg, msg
     # the right channel named: read
     scene.build(load_config(base({"map": str(tmp_path / "depth.exr"), "dataset": "A"})))
 
