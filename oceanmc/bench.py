@@ -482,11 +482,16 @@ def write_report(out_dir: Path, data: dict) -> None:
     (out_dir / "bench.md").write_text("\n".join(lines) + "\n")
 
 
+def fom_table(foms: list[dict]) -> dict[tuple[str, str], float]:
+    """The median FOM by (scene, quantity)."""
+    return {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+
+
 def fom_ratios(foms: list[dict]) -> dict[str, float]:
     """FOM of each local estimate over the crossing estimate of the same quantity: from a run
     with the crossing estimator only where the benchmark has one (each method timed alone, the
     fair ratio), else from the same run (both estimators share the run time)."""
-    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    table = fom_table(foms)
     out = {}
     for (scene, label), value in table.items():
         if label.endswith("(local)"):
@@ -504,7 +509,7 @@ def fom_ratios(foms: list[dict]) -> dict[str, float]:
 def variant_ratios(foms: list[dict], suffix: str) -> dict[str, float]:
     """FOM of each quantity of a scene run with a variant (the scene's name + suffix) over the
     FOM of the same quantity in the scene itself."""
-    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    table = fom_table(foms)
     return {f"{scene}, {label}": value / table[(scene, label)]
             for (name, label), value in table.items() if name.endswith(suffix)
             for scene in [name[:-len(suffix)]] if (scene, label) in table}
@@ -521,7 +526,7 @@ def upward_ratios(foms: list[dict]) -> dict[str, float]:
     for the local estimates with the bias, over plain photon counting (the crossing-only run)."""
     out = {f"{key}, biased over plain": value
            for key, value in variant_ratios(foms, UPWARD).items()}
-    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    table = fom_table(foms)
     for (name, label), value in table.items():
         if name.endswith(UPWARD) and label.endswith("(local)"):
             scene = name[:-len(UPWARD)]
@@ -535,7 +540,7 @@ def upward_ratios(foms: list[dict]) -> dict[str, float]:
 def sampling_ratios(foms: list[dict]) -> list[dict]:
     """Median FOM per quantity of the sky-spot scenes (importance, cosine, cosine with
     splitting) and the ratios importance / cosine and split / cosine."""
-    table = {(r["scene"], r["quantity"]): r["fom_median"] for r in foms}
+    table = fom_table(foms)
     out = []
     for (scene, label), fom in table.items():
         if scene == f"{SKY_SPOT} {IMPORTANCE}":

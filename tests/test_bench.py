@@ -3,7 +3,6 @@ these counts; the real run is committed in benchmarks/)."""
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 from conftest import REPO
 

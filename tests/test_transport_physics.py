@@ -71,7 +71,6 @@ def band_mu(r):
 def unique_quads(r, values):
     """Flattens (theta, phi) arrays to the distinct quads: a polar cap counts once."""
     values = np.asarray(values)
-    nphi = values.shape[-1]
     mask = np.ones(values.shape[-2:], dtype=bool)
     mask[0, 1:] = False
     mask[-1, 1:] = False

@@ -34,7 +34,7 @@ from numba import njit
 
 from . import local_estimate, upward
 from .brdf import dispatch as brdf
-from .geometry import from_angles, turn
+from .geometry import turn
 from .interface import reflectance, refract
 from .models import (BOTTOM_SPECULAR, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
                      BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING,

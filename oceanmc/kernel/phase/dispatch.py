@@ -5,7 +5,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..models import PHASE_HG, PHASE_ISOTROPIC, PHASE_QUADRATIC, PHASE_TABULATED
+from ..models import PHASE_HG, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
 
