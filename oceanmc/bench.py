@@ -32,7 +32,7 @@ from typing import Callable
 import numpy as np
 
 from .config import load_config
-from .kernel.interface import fresnel
+from .kernel.surface.fresnel import fresnel
 from .simulation import simulate
 
 

@@ -1,8 +1,11 @@
-"""simulate(config) -> Result: builds the scene arrays, runs the batches in groups on the
+"""simulate(config) -> Result: packs the scene (scene/), runs the batches in groups on the
 compiled kernel (a progress bar between groups), and hands the tallies to results.py."""
 from __future__ import annotations
 
 import math
+import sys
+import threading
+from concurrent.futures import ThreadPoolExecutor
 import time
 from pathlib import Path
 from typing import Any, Callable
@@ -13,9 +16,61 @@ from tqdm import tqdm
 
 from . import __version__, scene
 from .config import SceneConfig, config_to_yaml, load_config
-from .kernel.driver import features_of, photon_loop
-from .kernel.models import FEATURE_SPLITTING, SPLIT_STACK_ROWS, STACK_COLUMNS
-from .results import Result, budget_terms, from_tallies
+from .kernel import CACHE_DIR
+from .kernel.transport import trace_batch
+from .kernel.records import PACKET, SPLIT_STACK_ROWS
+from .results import Result, from_tallies
+from .scene.grid import tally_views
+
+
+class CompileInterrupted(Exception):
+    """The user asked to stop while the photon loop was compiling; nothing was traced."""
+
+
+COMPILE_NOTICE_AFTER_S = 1.0
+
+
+def compiled_batch(args: tuple, should_stop: Callable[[], bool] | None = None):
+    """trace_batch compiled for these argument types, or loaded from the disk cache. Every scene
+    has the same types, so this compiles once per kernel version and machine. The compilation
+    runs in a helper thread (LLVM releases the GIL) so that the main thread can say what is
+    happening every few seconds on stderr and stop at once on Ctrl-C (KeyboardInterrupt) or
+    when should_stop() says so (CompileInterrupted)."""
+    if not hasattr(trace_batch, "overloads"):  # NUMBA_DISABLE_JIT=1: plain Python
+        return trace_batch
+    signature = tuple(numba.typeof(a) for a in args)
+    if signature not in trace_batch.overloads:
+        failure = []
+
+        def compile_it():
+            try:
+                trace_batch.compile(signature)
+            except BaseException as exc:  # handed to the main thread
+                failure.append(exc)
+
+        worker = threading.Thread(target=compile_it, name="oceanmc-compile", daemon=True)
+        t0 = time.perf_counter()
+        worker.start()
+        said = 0.0
+        while worker.is_alive():
+            worker.join(0.1)
+            if should_stop is not None and should_stop():
+                raise CompileInterrupted("stopped while compiling the photon loop")
+            elapsed = time.perf_counter() - t0
+            if worker.is_alive() and elapsed >= COMPILE_NOTICE_AFTER_S and elapsed - said >= 5.0:
+                if not said:
+                    print(f"oceanmc: compiling the photon loop (once per oceanmc version on this "
+                          f"machine; cached in {CACHE_DIR})", file=sys.stderr, flush=True)
+                else:
+                    print(f"oceanmc: still compiling, {elapsed:.0f} s", file=sys.stderr,
+                          flush=True)
+                said = elapsed
+        if failure:
+            raise failure[0]
+        if said:
+            print(f"oceanmc: photon loop compiled in {time.perf_counter() - t0:.1f} s",
+                  file=sys.stderr, flush=True)
+    return trace_batch.overloads[signature].entry_point
 
 
 def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
@@ -36,26 +91,6 @@ def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
     return np.array(seeds, dtype=np.int64)
 
 
-def allocate(sc, n_batches: int, n_depths: int, grid, n_layers: int) -> dict[str, np.ndarray]:
-    """Per-batch tally arrays; levels are the tally depths, then 0+ (all light), then 0+
-    (water-leaving light only)."""
-    nt, npf = (len(grid.theta), len(grid.phi)) if sc.tally_radiance else (1, 1)
-    return {
-        "flux": np.zeros((n_batches, n_depths + 2, 4)),
-        "radiance": np.zeros((n_batches, n_depths + 2, nt, npf)),
-        "local": np.zeros((n_batches, n_depths + 1, sc.le_dirs.shape[0])),
-        "cap": np.zeros((n_batches, n_depths + 1)),
-        "budget": np.zeros((n_batches, len(budget_terms(n_layers)))),
-        "events": np.zeros(n_batches, dtype=np.int64),
-    }
-
-
-def _batches(raw: dict, lo: int, hi: int) -> tuple:
-    """The tally arrays of batches lo .. hi - 1, in the photon loop's argument order."""
-    return tuple(raw[name][lo:hi] for name in ("flux", "radiance", "local", "cap", "budget",
-                                                "events"))
-
-
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
              progress: bool = False, first_batch: int = 0,
              should_stop: Callable[[], bool] | None = None,
@@ -70,10 +105,11 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     checkpoint_every_s seconds."""
     if not isinstance(config, SceneConfig):
         config = load_config(config)
-    if threads is not None:
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-    n_threads = numba.get_num_threads()
-    sc, grid = scene.build(config)
+    # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
+    # number of cores) is the default and the most
+    n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
+        else max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    sc = scene.build(config)
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
     n_batches = config.batches - first_batch
@@ -81,16 +117,23 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_layers = len(config.water.layers)
     depths = config.tallies.depths_m
     seeds = batch_seeds(config.seed, config.batches)[first_batch:]
-    local_rows = scene.local_directions(config)[3]
-    raw = allocate(sc, n_batches, len(depths), grid, n_layers)
+    tallies = np.zeros((n_batches, sc.tally_size))
+    events = np.zeros(n_batches, dtype=np.int64)
+    packets = np.zeros(n_batches, dtype=PACKET)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
-    splitting = features_of(sc) & FEATURE_SPLITTING
-    stack = np.zeros((n_batches, SPLIT_STACK_ROWS if splitting else 1, STACK_COLUMNS))
+    stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
+    raw = dict(tally_views(sc.grid, tallies), events=events)
+
+    def batch(b: int) -> tuple:
+        return (n_per_batch, seeds[b], tallies[b], packets[b:b + 1], stacks[b])
 
     t0 = time.perf_counter()
-    # compiles this scene's loop (or loads it from the cache) outside the timing
-    loop = photon_loop(sc, n_per_batch, seeds, *_batches(raw, 0, 1), stack)
+    # compiles the loop (or loads it from the cache) outside the timing
+    trace = compiled_batch(sc.kernel_args() + batch(0), should_stop)
     startup = time.perf_counter() - t0
+
+    def run_batch(b: int) -> None:
+        events[b] = trace(*sc.kernel_args(), *batch(b))
 
     def result_of(done: int, wall: float) -> Result:
         photons = done * n_per_batch
@@ -112,18 +155,20 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "scattering_events": int(raw["events"][:done].sum()),
         }
         part = {name: values[:done] for name, values in raw.items()}
-        return from_tallies(part, grid, np.array(depths), n_per_batch,
-                            config.illumination.Ed0, n_layers, sc.tally_radiance, attrs,
-                            config.tallies.local_directions_deg, local_rows, sc.cap_estimates)
+        return from_tallies(part, sc.angles, np.array(depths), n_per_batch,
+                            config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
+                            config.tallies.local_directions_deg, sc.local_rows,
+                            config.nadir_local)
 
     group = max(1, n_threads)
     done = 0
     t1 = last_checkpoint = time.perf_counter()
     with tqdm(total=n_batches * n_per_batch, unit="photon", unit_scale=True, delay=1.0,
-              disable=not progress, desc=config.name[:40], leave=False) as bar:
+              disable=not progress, desc=config.name[:40], leave=False) as bar, \
+            ThreadPoolExecutor(max_workers=group) as pool:
         while done < n_batches:
             hi = min(n_batches, done + group)
-            loop(n_per_batch, seeds[done:hi], *_batches(raw, done, hi), stack[done:hi])
+            list(pool.map(run_batch, range(done, hi)))
             bar.update((hi - done) * n_per_batch)
             done = hi
             if should_stop is not None and should_stop():

@@ -40,7 +40,7 @@ for _stale in CACHE_DIR.parent.glob("numba-*"):
 _previous = numba.config.CACHE_DIR
 numba.config.CACHE_DIR = str(CACHE_DIR)
 try:
-    from . import driver  # noqa: E402,F401  (imports every kernel module)
+    from . import transport  # noqa: E402,F401  (imports every kernel module)
     from .brdf import dispatch as _brdf  # noqa: E402,F401
     from .phase import dispatch as _phase  # noqa: E402,F401
 finally:

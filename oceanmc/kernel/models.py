@@ -1,11 +1,16 @@
-"""Integer model ids shared by scene.py (which packs them) and the kernel (which dispatches on
-them). Module-level ints are compile-time constants for Numba."""
+"""Integer model ids shared by the packers (oceanmc/scene/, which pack them) and the kernel (which
+dispatches on them); their names are in kernel/registry.py. Module-level ints are compile-time
+constants for Numba."""
 
 # Phase function components (a layer's phase function is a weighted sum of components).
 PHASE_ISOTROPIC = 0
 PHASE_QUADRATIC = 1      # (1 + beta cos^2): Rayleigh-like (beta = 1), pure sea water (0.835)
 PHASE_HG = 2             # Henyey-Greenstein (g)
 PHASE_TABULATED = 3      # piecewise-linear 2 pi p sin(psi) on nodes: Petzold, FF, user tables
+
+# Air-water surfaces.
+SURFACE_NONE = 0         # no interface (index-matched)
+SURFACE_FLAT = 1         # flat: Fresnel + Snell
 
 # Bottoms.
 BOTTOM_NONE = 0          # infinitely deep water: no bottom plane is ever reached
@@ -18,9 +23,9 @@ BOTTOM_GGX = 6           # GGX / Trowbridge-Reitz microfacets, Smith shadowing, 
 BOTTOM_HAPKE = 7         # Hapke (1981/1993) with the shadow-hiding opposition (hot-spot) term
 BOTTOM_TABLE = 8         # measured BRDF on an angular grid (isotropic or anisotropic), from a file
 
-# The bottom parameter array (sc.bottom_params, float64): the model's scalar parameters in slots
-# 0 .. BRDF_NSCALARS - 1, then a header, then any tables (brdf_tables.py packs it). Offsets are
-# stored as floats (exact below 2^53) and read with int().
+# The bottom parameter array (the bottom pool, float64): the model's scalar parameters in slots
+# 0 .. BRDF_NSCALARS - 1, then a header, then any tables (scene/brdf_tables.py packs it).
+# Offsets are stored as floats (exact below 2^53) and read with int().
 BRDF_NSCALARS = 8
 BRDF_SAMPLER = 8         # 0: the model's own sampler; 1: the general tabulated sampler
 BRDF_SAMPLER_AT = 9      # offset of the general sampler's tables (brdf/general.py)
@@ -33,20 +38,6 @@ SKY_CARDIOIDAL = 1       # L ~ 1 + 2 cos(zenith angle): the CIE standard overcas
 SKY_MAP = 2              # a tabulated radiance map, piecewise constant on its cells (sky_maps.py)
 SKY_HARRISON_COOMBES = 3  # Harrison & Coombes (1988) clear sky; a fine map as the proposal
 SKY_MAP_COSINE = 4       # a map sampled cosine-weighted, each photon weighted by its cell's L
-
-# Features a scene uses, as bits of the compile-time constant `features` of the photon loop
-# (kernel/driver.py): code for a feature a scene does not use is not compiled into its loop.
-FEATURE_SKY = 1          # sky photons (diffuse_fraction > 0)
-FEATURE_BOTTOM = 2       # a reflecting bottom (not none or black)
-FEATURE_RADIANCE = 4     # the radiance quad tallies
-FEATURE_ESTIMATES = 8    # local estimates: exact directions and/or the nadir polar cap
-FEATURE_SPLITTING = 16   # splitting of packets heavier than estimator.split_weight
-FEATURE_UPWARD = 32      # scattering biased toward straight up (estimator.upward_fraction)
-
-# Packets waiting after a split (transport.split): one row per packet, its start state.
-SPLIT_STACK_ROWS = 64
-STACK_Z, STACK_SEGMENT, STACK_WEIGHT, STACK_UX, STACK_UY, STACK_UZ, STACK_BEAM = range(7)
-STACK_COLUMNS = 7
 
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0

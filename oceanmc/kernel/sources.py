@@ -1,6 +1,6 @@
 """Where photons come from: the sun's collimated beam and the sky's diffuse radiance, sampled in
 proportion to their contribution to the downward plane irradiance just above the surface
-(sky_maps.py documents the sky shapes and the map conventions)."""
+(scene/sky_maps.py documents the sky shapes and the map conventions)."""
 import math
 
 import numpy as np
@@ -25,32 +25,19 @@ def sky_cosine(sky_model):
 
 
 @njit(error_model="numpy", cache=True)
-def first_above_cell(cdf, row, u):
-    """Smallest k with u < cdf[row, k] (indexed, not sliced: no view in the photon loop)."""
-    lo = -1
-    hi = cdf.shape[1] - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if u < cdf[row, mid]:
-            hi = mid
-        else:
-            lo = mid
-    return hi
+def harrison_coombes(sf, p, ux, uy, uz):
+    """Harrison & Coombes (1988) radiance of the sky element a photon travelling (ux, uy, uz)
+    comes from (sf[p:p + 4]: sun travel direction, cos of the sun zenith); sky_maps.py has the
+    formula."""
+    cos_psi = min(1.0, max(-1.0, ux * sf[p] + uy * sf[p + 1] + uz * sf[p + 2]))
+    psi = math.acos(cos_psi)
+    horizon = 1.0 - math.exp(-0.19 / uz) if uz > 0.0 else 1.0
+    return ((1.63 + 53.7 * math.exp(-5.49 * psi) + 2.04 * cos_psi * cos_psi * sf[p + 3])
+            * horizon * (1.0 - math.exp(-0.53 / sf[p + 3])))
 
 
 @njit(error_model="numpy", cache=True)
-def harrison_coombes(p, ux, uy, uz):
-    """Harrison & Coombes (1988) radiance of the sky element a photon travelling (ux, uy, uz)
-    comes from (p: sun travel direction, cos of the sun zenith); sky_maps.py has the formula."""
-    cos_psi = min(1.0, max(-1.0, ux * p[0] + uy * p[1] + uz * p[2]))
-    psi = math.acos(cos_psi)
-    horizon = 1.0 - math.exp(-0.19 / uz) if uz > 0.0 else 1.0
-    return ((1.63 + 53.7 * math.exp(-5.49 * psi) + 2.04 * cos_psi * cos_psi * p[3]) * horizon
-            * (1.0 - math.exp(-0.53 / p[3])))
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def sky_direction(sc):
+def sky_direction(sky, sf):
     """(ux, uy, uz, weight factor) of a sky photon's travel direction. Tabulated skies: a row by
     the marginal CDF, a cell by the row's conditional CDF, sin^2(theta) and phi uniform within
     the cell (density exactly proportional to the cell's L cos); the map gives the view
@@ -58,32 +45,33 @@ def sky_direction(sc):
     by L(direction) / L(cell), so its exact radiance is reproduced; maps and the analytic shapes
     have factor 1. A cosine-sampled map draws sin^2(theta) and phi_view uniformly (density
     cos / pi over the hemisphere), finds the cell by bisection on the same edges and takes the
-    cell's L pi / E as the factor (sky_cell_L holds it; sky_maps.cosine_weights)."""
-    model = sc.sky_model
+    cell's L pi / E as the factor (the cell_l table holds it; sky_maps.cosine_weights)."""
+    model = sky.model
     if model == SKY_MAP or model == SKY_HARRISON_COOMBES or model == SKY_MAP_COSINE:
+        n_cols = sky.n_cols
         if model == SKY_MAP_COSINE:
             s = np.random.random()
-            phi_view = sc.sky_phi_edges[0] + 2.0 * math.pi * np.random.random()
+            phi_view = sf[sky.phi_edges] + 2.0 * math.pi * np.random.random()
             # the cell holding (s, phi_view): one before the first edge above it (the last cell
             # if rounding puts phi_view on the final edge)
-            row = first_above(sc.sky_s_edges, 0, sc.sky_s_edges.shape[0], s) - 1
-            col = first_above(sc.sky_phi_edges, 0, sc.sky_phi_edges.shape[0], phi_view) - 1
+            row = first_above(sf, sky.s_edges, sky.n_rows + 1, s) - 1
+            col = first_above(sf, sky.phi_edges, n_cols + 1, phi_view) - 1
         else:
-            row = first_above(sc.sky_row_cdf, 0, sc.sky_row_cdf.shape[0], np.random.random())
-            col = first_above_cell(sc.sky_cell_cdf, row, np.random.random())
-            s0 = sc.sky_s_edges[row]
-            s = s0 + np.random.random() * (sc.sky_s_edges[row + 1] - s0)
-            p0 = sc.sky_phi_edges[col]
-            phi_view = p0 + np.random.random() * (sc.sky_phi_edges[col + 1] - p0)
+            row = first_above(sf, sky.row_cdf, sky.n_rows, np.random.random())
+            col = first_above(sf, sky.cell_cdf + row * n_cols, n_cols, np.random.random())
+            s0 = sf[sky.s_edges + row]
+            s = s0 + np.random.random() * (sf[sky.s_edges + row + 1] - s0)
+            p0 = sf[sky.phi_edges + col]
+            phi_view = p0 + np.random.random() * (sf[sky.phi_edges + col + 1] - p0)
         sin_t = math.sqrt(min(1.0, max(0.0, s)))
         uz = math.sqrt(max(0.0, 1.0 - s))
         ux = -sin_t * math.cos(phi_view)
         uy = -sin_t * math.sin(phi_view)
+        cell_l = sf[sky.cell_l + row * n_cols + col]
         if model == SKY_HARRISON_COOMBES:
-            return ux, uy, uz, harrison_coombes(sc.sky_params, ux, uy, uz) \
-                / sc.sky_cell_L[row, col]
+            return ux, uy, uz, harrison_coombes(sf, sky.params, ux, uy, uz) / cell_l
         if model == SKY_MAP_COSINE:
-            return ux, uy, uz, sc.sky_cell_L[row, col]
+            return ux, uy, uz, cell_l
         return ux, uy, uz, 1.0
     mu = sky_cosine(model)
     ux, uy, uz = from_angles(mu, 2.0 * math.pi * np.random.random())
@@ -91,12 +79,13 @@ def sky_direction(sc):
 
 
 @njit(error_model="numpy", cache=True)
-def sky_many(sc, n, seed):
+def sky_many(sky_record, sf, n, seed):
     """Rows (ux, uy, uz, weight factor) of n sky photons from seed (tests and reports)."""
     np.random.seed(seed)
+    sky = sky_record[0]
     out = np.empty((n, 4))
     for k in range(n):
-        ux, uy, uz, m = sky_direction(sc)
+        ux, uy, uz, m = sky_direction(sky, sf)
         out[k, 0] = ux
         out[k, 1] = uy
         out[k, 2] = uz

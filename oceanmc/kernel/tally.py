@@ -1,17 +1,21 @@
-"""Plane-crossing tallies: a photon of weight w crossing a level with direction cosine mu adds w
-to Ed or Eu, w/|mu| to Eod or Eou and to the radiance of its quad (normalised by the quad's solid
-angle and the photon count later, in results.py). Grazing crossings use the surface-flux rule:
-1/|mu| is replaced by 2/mu_cut when |mu| < mu_cut, which is exact when the radiance is constant
-over |mu| < mu_cut and keeps the variance finite (MCNP manual, F2 surface flux tally).
+"""Plane-crossing tallies, the one crossing scorer: a photon of weight w crossing a level with
+direction cosine mu adds w to Ed or Eu, w/|mu| to Eod or Eou and to the radiance of its quad
+(normalised by the quad's solid angle and the photon count later, in run/results.py). Grazing
+crossings use the surface-flux rule: 1/|mu| is replaced by 2/mu_cut when |mu| < mu_cut, which is
+exact when the radiance is constant over |mu| < mu_cut and keeps the variance finite (MCNP
+manual, F2 surface flux tally).
 
-Levels: the in-water tally depths first, then sc.air_level (0+, all light) and sc.air_level + 1
-(0+, water-leaving light only). Arrays are indexed, never sliced, in the loop: a view costs a
-reference-count update."""
+Tallies as OpenMC thinks of them: filters (level, theta band, phi band) times scores (Ed, Eu,
+Eod, Eou, radiance), in one flat row per batch (kernel/records.py, GRID). Levels: the in-water
+tally depths first, then grid.air_level (0+, all light) and grid.air_level + 1 (0+, water-leaving
+light only)."""
 import math
 
 from numba import njit
 
-from .models import FEATURE_RADIANCE, FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
+from .compile import internal
+
+from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
 @njit(error_model="numpy", cache=True)
@@ -28,16 +32,16 @@ def theta_band(uz, mu_edges):
     return lo
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def theta_band_fast(sc, uz):
-    """theta_band by table: sc.theta_lookup[k] is the band of the top of the k-th of M equal
-    cells of uz in [-1, 1]; lower values in the same cell can only be in that band or a later
-    one, so a short walk down the edges finishes the job exactly."""
-    m = sc.theta_lookup.shape[0]
+@njit(error_model="numpy", cache=True)
+def theta_band_fast(grid, gf, gi, uz):
+    """theta_band by table: theta_lookup[k] is the band of the top of the k-th of M equal cells
+    of uz in [-1, 1]; lower values in the same cell can only be in that band or a later one, so
+    a short walk down the edges finishes the job exactly."""
+    m = grid.n_lookup
     k = min(m - 1, int((uz + 1.0) * (0.5 * m)))
-    band = sc.theta_lookup[k]
-    last = sc.theta_mu_edges.shape[0] - 2
-    while band < last and uz <= sc.theta_mu_edges[band + 1]:
+    band = gi[grid.theta_lookup + k]
+    last = grid.n_theta - 1
+    while band < last and uz <= gf[grid.theta_mu_edges + band + 1]:
         band += 1
     return band
 
@@ -50,13 +54,13 @@ def phi_band(ux, uy, n_phi):
     return k % n_phi
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def phi_band_fast(sc, ux, uy):
+@njit(error_model="numpy", cache=True)
+def phi_band_fast(grid, gf, ux, uy):
     """phi_band without atan2: a polynomial guess of the azimuth (error < 0.0038 rad; Rajan et
     al. 2006, IEEE Signal Process. Mag. 23(3)). The bands are equal, so a guess farther than
     0.0063 rad (0.001 n bands) from an edge is the band; near an edge, exact tests against the
     edge directions (sign of the 2-D cross product) move it to the right band."""
-    n = sc.n_phi
+    n = grid.n_phi
     if n <= 2:
         return phi_band(ux, uy, n)
     ax = abs(ux)
@@ -78,11 +82,13 @@ def phi_band_fast(sc, ux, uy):
     if 0.001 * n < frac < 1.0 - 0.001 * n:
         return k
     # band k lies between edge k (inclusive) and edge k + 1 (exclusive), counterclockwise
-    while sc.phi_edge_cos[k] * uy - sc.phi_edge_sin[k] * ux < 0.0:
+    cos_at = grid.phi_edge_cos
+    sin_at = grid.phi_edge_sin
+    while gf[cos_at + k] * uy - gf[sin_at + k] * ux < 0.0:
         k = k - 1 if k > 0 else n - 1
     while True:
         up = k + 1 if k + 1 < n else 0
-        if sc.phi_edge_cos[up] * uy - sc.phi_edge_sin[up] * ux < 0.0:
+        if gf[cos_at + up] * uy - gf[sin_at + up] * ux < 0.0:
             return k
         k = up
 
@@ -96,35 +102,26 @@ def inverse_mu(uz, mu_cut, beam):
     return 1.0 / amu if (amu >= mu_cut or beam) else 2.0 / mu_cut
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def score_levels(sc, features, flux, radiance, level, second, w, ux, uy, uz, beam):
+@internal
+def score_crossing(grid, gf, gi, tally, level, second, w, ux, uy, uz, beam):
     """A crossing of tally level `level` (an in-water depth, or the air levels after them), and
     of level `second` too when second >= 0 (the same crossing counted twice: the bands are found
     once); beam: the packet is still part of the collimated solar beam."""
-    w_over_mu = w * inverse_mu(uz, sc.mu_cut, beam)
+    w_over_mu = w * inverse_mu(uz, grid.mu_cut, beam)
     col_e = FLUX_ED if uz > 0.0 else FLUX_EU
     col_eo = FLUX_EOD if uz > 0.0 else FLUX_EOU
-    flux[level, col_e] += w
-    flux[level, col_eo] += w_over_mu
+    at = grid.flux + 4 * level
+    tally[at + col_e] += w
+    tally[at + col_eo] += w_over_mu
     if second >= 0:
-        flux[second, col_e] += w
-        flux[second, col_eo] += w_over_mu
-    if features & FEATURE_RADIANCE:
-        band = theta_band_fast(sc, uz)
-        col = 0 if sc.theta_is_cap[band] else phi_band_fast(sc, ux, uy)
-        radiance[level, band, col] += w_over_mu
+        at = grid.flux + 4 * second
+        tally[at + col_e] += w
+        tally[at + col_eo] += w_over_mu
+    if grid.radiance_on:
+        band = theta_band_fast(grid, gf, gi, uz)
+        col = 0 if gi[grid.theta_is_cap + band] else phi_band_fast(grid, gf, ux, uy)
+        quad = band * grid.phi_cols + col
+        per_level = grid.theta_cols * grid.phi_cols
+        tally[grid.radiance + level * per_level + quad] += w_over_mu
         if second >= 0:
-            radiance[second, band, col] += w_over_mu
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def score(sc, features, flux, radiance, level, w, ux, uy, uz, beam):
-    score_levels(sc, features, flux, radiance, level, -1, w, ux, uy, uz, beam)
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def score_air_up(sc, features, flux, radiance, w, ux, uy, uz, water_leaving, beam):
-    """Light travelling up at 0+: all of it at sc.air_level, and what came out of the water also
-    at the water-leaving level after it."""
-    score_levels(sc, features, flux, radiance, sc.air_level,
-                 sc.air_level + 1 if water_leaving else -1, w, ux, uy, uz, beam)
+            tally[grid.radiance + second * per_level + quad] += w_over_mu

@@ -1,268 +1,342 @@
 """The photon loop: weighted photon packets from the sun and sky, through the surface, the layered
 water and off the bottom, until they leave, are absorbed or lose Russian roulette.
 
-Estimator (sc.analog False, the default): implicit capture (a collision keeps the packet and
-multiplies its weight by the single-scattering albedo), expected values at the surface (light
-from the air: the reflected part w R is scored and the packet enters with w (1 - R); light from
-the water: the leaving part w (1 - R) is scored, and the packet goes on, reflected, with
-probability R and weight w), weight times rho_dh at the bottom, exact exponential attenuation in layers that do not scatter, and unbiased Russian
-roulette below sc.roulette_weight; optionally, scattering biased toward straight up (upward.py)
-and splitting of heavy packets. Analog mode decides each of these with a random draw instead.
-Either way every quantity has the same expectation; only the variance differs.
+The walk is a sequence of events, each an ordinary compiled function with one call site:
+free_flight (to the next collision or plane), collide, cross_plane, and behind a plane the
+surface from below (leave_or_reflect) or the bottom (reflect_at_bottom); a packet from the air
+meets the surface in enter_from_air. Only trace_batch sees the whole scene; each event takes
+the component records and pools it needs (kernel/records.py) and the packet, a PACKET record
+that it updates in place.
 
-Every function that takes the scene (one large named tuple) is compiled with inline="always":
-a real call copies the tuple (measured: 3x fewer photons/s without inlining). Functions of
-scalars are left to LLVM, which inlines them where it pays: inlining those too in Numba's IR made
-the first compilation 5x longer (240 s against 45 s) for 8% more photons/s.
+Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
+and multiplies its weight by the single-scattering albedo), expected values at the surface
+(light from the air: the reflected part w R is scored and the packet enters with w (1 - R);
+light from the water: the leaving part w (1 - R) is scored, and the packet goes on, reflected,
+with probability R and weight w), weight times rho_dh at the bottom, exact exponential
+attenuation in layers that do not scatter, and unbiased Russian roulette below
+roulette_weight; optionally, scattering biased toward straight up (upward.py) and splitting of
+heavy packets. Analog mode decides each of these with a random draw instead. Either way every
+quantity has the same expectation; only the variance differs.
 
-`features` (bits FEATURE_* of models.py) is a compile-time constant: driver.py compiles the loop
-once per combination of features a scene uses, and code behind a feature bit that is off is not
-in that loop at all (measured on the bare-walk scene: ~10% more photons/s than with the unused
-code present behind runtime tests). A scene whose features have not been compiled before pays
-one compilation (cached on disk afterwards).
-
-trace_batch is compiled without Numba's reference counting (_nrt=False): every read of an array
-field of the scene tuple in inlined code otherwise costs an atomic incref/decref pair (1500 call
-sites in the compiled loop; 1.8x to 2.4x fewer photons/s, and both threads contending for the
-same counters). The arrays are borrowed from the caller, which holds them for the whole call,
-and nothing in the loop allocates.
+The random draws come in the same order as in the kernel before the event loop (the flat
+surface with n_water = 1 aside, where the old loop drew one number it did not need), so runs
+are reproduced bit for bit (benchmarks/regression.md).
 """
 import math
 
 import numpy as np
 from numba import njit
 
+from .compile import internal
+
 from . import local_estimate, upward
 from .brdf import dispatch as brdf
 from .geometry import turn
-from .interface import reflectance, refract
-from .models import (BOTTOM_SPECULAR, BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW,
-                     BUDGET_SURFACE_REFLECTION, BUDGET_TRUNCATED, BUDGET_WATER_LEAVING,
-                     FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_SKY, FEATURE_SPLITTING,
-                     FEATURE_UPWARD, STACK_BEAM, STACK_SEGMENT, STACK_UX, STACK_UY, STACK_UZ,
-                     STACK_WEIGHT, STACK_Z)
+from .models import (BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, BUDGET_SURFACE_REFLECTION,
+                     BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
 from .phase import dispatch as phase
 from .sources import sky_direction
-from .tally import score, score_air_up
+from .surface import dispatch as surface_bsdf
+from .tally import score_crossing
+
+# what a free flight ends in
+FLIGHT_COLLISION = 0
+FLIGHT_PLANE = 1
+FLIGHT_GONE = 2     # absorbed in, or lost below, a layer that does not scatter
 
 
-@njit(error_model="numpy", cache=True)
+@internal
 def exponential():
     return -math.log(1.0 - np.random.random())
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def survives_roulette(sc, w):
-    """(alive, new weight): below the threshold a packet survives with probability p and then
-    carries w/p, so the expected weight is unchanged."""
-    if sc.analog or w >= sc.roulette_weight:
-        return True, w
-    if np.random.random() < sc.roulette_survival:
-        return True, w / sc.roulette_survival
-    return False, 0.0
+@internal
+def launch(p, w, ux, uy, uz, beam):
+    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz)."""
+    p.z = 0.0
+    p.seg = 0
+    p.w = w
+    p.ux = ux
+    p.uy = uy
+    p.uz = uz
+    p.beam = beam
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam):
-    """Splitting by weight: a packet heavier than sc.split_weight becomes k = floor(w /
+@internal
+def copy_packet(dst, src):
+    dst.z = src.z
+    dst.w = src.w
+    dst.ux = src.ux
+    dst.uy = src.uy
+    dst.uz = src.uz
+    dst.seg = src.seg
+    dst.beam = src.beam
+    dst.wavelength = src.wavelength
+
+
+@internal
+def survives_roulette(ctrl, p):
+    """Below the threshold a packet survives with probability s and then carries w/s, so the
+    expected weight is unchanged."""
+    if ctrl.analog or p.w >= ctrl.roulette_weight:
+        return True
+    if np.random.random() < ctrl.roulette_survival:
+        p.w /= ctrl.roulette_survival
+        return True
+    return False
+
+
+@internal
+def split(ctrl, stack, n_stacked, p):
+    """Splitting by weight: a packet heavier than split_weight becomes k = floor(w /
     split_weight) + 1 packets of weight w / k, each lighter than split_weight, that go on
     independently from the same state (the walk has no memory, so each is an unbiased copy;
     Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2). All but one wait on the stack, as many as
-    it has room for (fewer, heavier copies are as unbiased). Returns (w, n_stacked)."""
-    copies = min(int(w / sc.split_weight) + 1, stack.shape[0] - n_stacked + 1)
+    it has room for (fewer, heavier copies are as unbiased). Returns the new stack height."""
+    copies = min(int(p.w / ctrl.split_weight) + 1, stack.shape[0] - n_stacked + 1)
     if copies <= 1:
-        return w, n_stacked
-    w /= copies
+        return n_stacked
+    p.w /= copies
     for _ in range(copies - 1):
-        stack[n_stacked, STACK_Z] = z
-        stack[n_stacked, STACK_SEGMENT] = seg
-        stack[n_stacked, STACK_WEIGHT] = w
-        stack[n_stacked, STACK_UX] = ux
-        stack[n_stacked, STACK_UY] = uy
-        stack[n_stacked, STACK_UZ] = uz
-        stack[n_stacked, STACK_BEAM] = 1.0 if beam else 0.0
+        copy_packet(stack[n_stacked], p)
         n_stacked += 1
-    return w, n_stacked
+    return n_stacked
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def enter_water(sc, features, w, ux, uy, uz, beam, flux, radiance, budget):
-    """A packet from the air meets the surface: scores it at 0+ (incoming, and the reflected
-    part), and returns (enters, w, ux, uy, uz) for what goes into the water, scored at 0-.
-    Linear in w: in implicit mode the whole solar beam of a batch enters in one call."""
-    score(sc, features, flux, radiance, sc.air_level, w, ux, uy, uz, beam)
-    n = sc.n_water
-    if sc.surface_flat:
-        r, cos_t = reflectance(sc, 1.0, n, uz)
-        if sc.analog:
-            if np.random.random() < r:
-                score_air_up(sc, features, flux, radiance, w, ux, uy, -uz, False, beam)
-                budget[BUDGET_SURFACE_REFLECTION] += w
-                return False, 0.0, ux, uy, uz
+@internal
+def enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
+    """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
+    and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
+    implicit mode the whole solar beam of a batch enters in one call."""
+    air = grid.air_level
+    w = p.w
+    score_crossing(grid, gf, gi, tally, air, -1, w, p.ux, p.uy, p.uz, p.beam)
+    r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    budget = grid.budget
+    if ctrl.analog:
+        if r > 0.0 and np.random.random() < r:
+            score_crossing(grid, gf, gi, tally, air, -1, w, rx, ry, rz, p.beam)
+            tally[budget + BUDGET_SURFACE_REFLECTION] += w
+            return False
+    else:
+        if r > 0.0:
+            score_crossing(grid, gf, gi, tally, air, -1, w * r, rx, ry, rz, p.beam)
+            tally[budget + BUDGET_SURFACE_REFLECTION] += w * r
+        p.w = w * (1.0 - r)
+    p.ux = tx
+    p.uy = ty
+    p.uz = tz
+    if grid.surface_level >= 0:
+        score_crossing(grid, gf, gi, tally, grid.surface_level, -1, p.w, tx, ty, tz, p.beam)
+    return True
+
+
+@internal
+def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau):
+    """Moves the packet through its segment with tau optical depths left to its next
+    collision: (FLIGHT_COLLISION, layer, 0) at a collision, (FLIGHT_PLANE, plane, tau left) on
+    reaching the plane ahead, or (FLIGHT_GONE, -1, 0) when a layer that does not scatter
+    absorbs it or it leaves down an infinitely deep one (attenuation there is exact: weight
+    times exp(-c dist), or survival with that probability in the analog walk)."""
+    seg = p.seg
+    layer = mi[medium.segment_layer + seg]
+    c = mf[medium.layer_c + layer]
+    albedo = mf[medium.layer_albedo + layer]
+    uz = p.uz
+    if uz > 0.0:
+        target = seg + 1
+        dist = (mf[medium.plane_z + target] - p.z) / uz
+    elif uz < 0.0:
+        target = seg
+        dist = (mf[medium.plane_z + target] - p.z) / uz
+    else:
+        target = -1
+        dist = math.inf
+    budget = grid.budget
+    if albedo > 0.0:
+        s = tau * mf[medium.layer_inv_c + layer]
+        if s < dist:
+            p.z += s * uz
+            return FLIGHT_COLLISION, layer, 0.0
+        tau -= dist * c
+    elif dist == math.inf:
+        # no scattering and no plane ahead: down an infinitely deep clear layer, or level
+        tally[budget + ((BUDGET_LAYERS + layer) if c > 0.0 else BUDGET_LOST_BELOW)] += p.w
+        return FLIGHT_GONE, -1, 0.0
+    elif c > 0.0:
+        transmitted = math.exp(-c * dist)
+        if ctrl.analog:
+            if np.random.random() >= transmitted:
+                tally[budget + BUDGET_LAYERS + layer] += p.w
+                return FLIGHT_GONE, -1, 0.0
         else:
-            if r > 0.0:
-                score_air_up(sc, features, flux, radiance, w * r, ux, uy, -uz, False, beam)
-                budget[BUDGET_SURFACE_REFLECTION] += w * r
-            w *= 1.0 - r
-        ux, uy, uz = refract(ux, uy, uz, 1.0 / n, cos_t)
-    if sc.surface_tally >= 0:
-        score(sc, features, flux, radiance, sc.surface_tally, w, ux, uy, uz, beam)
-    return True, w, ux, uy, uz
+            tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
+            p.w *= transmitted
+    if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
+        tally[budget + BUDGET_LOST_BELOW] += p.w
+        return FLIGHT_GONE, -1, 0.0
+    p.z = mf[medium.plane_z + target]
+    return FLIGHT_PLANE, target, tau
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def trace_in_water(sc, features, z, seg, w, ux, uy, uz, beam, flux, radiance, local, cap,
-                   budget, stack, n_stacked):
-    """Follows one packet from depth z on plane or in segment seg (just below the surface, or a
-    split copy at the bottom) until it leaves, is absorbed or loses roulette; returns its
-    scattering count and the new number of packets on the stack. beam: it belongs to the
-    collimated solar beam (until it scatters or meets a diffuse bottom)."""
-    n = sc.n_water
-    plane_z = sc.plane_z
-    bottom_plane = plane_z.shape[0] - 1
+@internal
+def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events):
+    """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
+    a new direction, roulette. Returns (alive, optical depth to the next collision)."""
+    albedo = mf[medium.layer_albedo + layer]
+    w = p.w
+    if est.directions_on or est.cap_on:
+        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, p.seg, layer,
+                                    p.z, w * albedo, p.ux, p.uy, p.uz)
+    budget = grid.budget
+    if ctrl.analog:
+        if np.random.random() >= albedo:
+            tally[budget + BUDGET_LAYERS + layer] += w
+            return False, 0.0
+    else:
+        scattered = w * albedo
+        tally[budget + BUDGET_LAYERS + layer] += w - scattered
+        w = scattered
+    if ctrl.upward:
+        w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz)
+    else:
+        u_pick = np.random.random() if mi[medium.comp_count + layer] > 1 else 0.0
+        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, np.random.random())
+        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, np.random.random())
+    p.w = w
+    p.ux = ux
+    p.uy = uy
+    p.uz = uz
+    p.beam = 0
+    tau = exponential()
+    if not survives_roulette(ctrl, p):
+        return False, tau
+    if events >= ctrl.max_events:
+        tally[budget + BUDGET_TRUNCATED] += p.w
+        return False, tau
+    return True, tau
+
+
+@internal
+def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p):
+    """A packet meets the surface from below: what leaves is scored at 0+ (all light and
+    water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
+    with probability R, carrying w, so a weak internally reflected packet costs no more than in
+    an analog walk). Returns whether the packet goes on."""
+    r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    air = grid.air_level
+    w = p.w
+    if ctrl.analog:
+        if r <= 0.0 or np.random.random() >= r:
+            score_crossing(grid, gf, gi, tally, air, air + 1, w, tx, ty, tz, p.beam)
+            tally[grid.budget + BUDGET_WATER_LEAVING] += w
+            return False
+    else:
+        leaving = w * (1.0 - r)
+        if leaving > 0.0:
+            score_crossing(grid, gf, gi, tally, air, air + 1, leaving, tx, ty, tz, p.beam)
+            tally[grid.budget + BUDGET_WATER_LEAVING] += leaving
+        if r <= 0.0 or (r < 1.0 and np.random.random() >= r):
+            return False
+    p.ux = rx
+    p.uy = ry
+    p.uz = rz
+    p.seg = 0
+    return True
+
+
+@internal
+def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, p):
+    """A packet meets the bottom: local estimates of what it reflects, a reflected direction
+    sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
+    whether the packet goes on."""
+    budget = grid.budget
+    if not bottom.reflects:  # black (an infinitely deep bottom is never met)
+        tally[budget + BUDGET_BOTTOM] += p.w
+        return False
+    if est.directions_on or est.cap_on:
+        local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
+                                 p.w, p.ux, p.uy, p.uz)
+    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, np.random.random(),
+                                   np.random.random())
+    p.ux = ux
+    p.uy = uy
+    p.uz = uz
+    p.beam = 1 if (p.beam != 0 and bottom.mirror != 0) else 0
+    if ctrl.analog:
+        if np.random.random() >= rho:
+            tally[budget + BUDGET_BOTTOM] += p.w
+            return False
+    else:
+        tally[budget + BUDGET_BOTTOM] += p.w * (1.0 - rho)
+        p.w *= rho
+    p.seg = medium.n_planes - 2
+    return True
+
+
+@internal
+def cross_plane(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi, est, ef, ei, tally,
+                stack, n_stacked, p, target):
+    """The packet is on plane `target`: scored if the plane is a tally level; at the surface or
+    the bottom it leaves, is absorbed or is reflected (and then crosses the level again, may be
+    split, and plays roulette); elsewhere it enters the next segment. Returns (alive, stack
+    height)."""
+    level = mi[medium.plane_tally + target]
+    if level >= 0:
+        score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
+    if target == 0:
+        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p)
+    elif target == medium.n_planes - 1:
+        alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei,
+                                  tally, p)
+    else:
+        p.seg = target if p.uz > 0.0 else target - 1
+        return True, n_stacked
+    if not alive:
+        return False, n_stacked
+    if level >= 0 and p.w > 0.0:
+        score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
+    if ctrl.splitting and p.w > ctrl.split_weight:
+        n_stacked = split(ctrl, stack, n_stacked, p)
+    return survives_roulette(ctrl, p), n_stacked
+
+
+@internal
+def walk(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi, est, ef, ei, tally, stack,
+         n_stacked, p):
+    """Follows packet p in the water (just below the surface, or a split copy) until it leaves,
+    is absorbed or loses roulette; returns its scattering count and the stack height."""
     tau = exponential()
     events = 0
-    while True:
-        if w <= 0.0:
-            return events, n_stacked
-        layer = sc.segment_layer[seg]
-        c = sc.layer_c[layer]
-        albedo = sc.layer_albedo[layer]
-        if uz > 0.0:
-            target = seg + 1
-            dist = (plane_z[target] - z) / uz
-        elif uz < 0.0:
-            target = seg
-            dist = (plane_z[target] - z) / uz
+    while p.w > 0.0:
+        outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau)
+        if outcome == FLIGHT_COLLISION:
+            events += 1
+            alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, where,
+                                 events)
+        elif outcome == FLIGHT_PLANE:
+            alive, n_stacked = cross_plane(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf,
+                                           gi, est, ef, ei, tally, stack, n_stacked, p, where)
         else:
-            target = -1
-            dist = math.inf
-        if albedo > 0.0:
-            s = tau * sc.layer_inv_c[layer]
-            if s < dist:
-                z += s * uz
-                events += 1
-                if features & FEATURE_ESTIMATES:
-                    if sc.local_estimates:
-                        local_estimate.score_collision(sc, local, seg, layer, z, w * albedo,
-                                                       ux, uy, uz)
-                    if sc.cap_estimates:
-                        local_estimate.cap_collision(sc, cap, seg, layer, z, w * albedo, uz)
-                if sc.analog:
-                    if np.random.random() >= albedo:
-                        budget[BUDGET_LAYERS + layer] += w
-                        return events, n_stacked
-                else:
-                    scattered = w * albedo
-                    budget[BUDGET_LAYERS + layer] += w - scattered
-                    w = scattered
-                if features & FEATURE_UPWARD:
-                    w, ux, uy, uz = upward.scatter(sc, layer, w, ux, uy, uz)
-                else:
-                    u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
-                    cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
-                    ux, uy, uz = turn(ux, uy, uz, cos_s, np.random.random())
-                beam = False
-                tau = exponential()
-                alive, w = survives_roulette(sc, w)
-                if not alive:
-                    return events, n_stacked
-                if events >= sc.max_events:
-                    budget[BUDGET_TRUNCATED] += w
-                    return events, n_stacked
-                continue
-            tau -= dist * c
-        elif dist == math.inf:
-            # no scattering and no plane ahead: down an infinitely deep clear layer, or level
-            budget[(BUDGET_LAYERS + layer) if c > 0.0 else BUDGET_LOST_BELOW] += w
-            return events, n_stacked
-        elif c > 0.0:
-            transmitted = math.exp(-c * dist)
-            if sc.analog:
-                if np.random.random() >= transmitted:
-                    budget[BUDGET_LAYERS + layer] += w
-                    return events, n_stacked
-            else:
-                budget[BUDGET_LAYERS + layer] += w * (1.0 - transmitted)
-                w *= transmitted
-        if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
-            budget[BUDGET_LOST_BELOW] += w
-            return events, n_stacked
-
-        z = plane_z[target]
-        level = sc.plane_tally[target]
-        if level >= 0:
-            score(sc, features, flux, radiance, level, w, ux, uy, uz, beam)
-
-        if target == 0:
-            # at the surface from below
-            if not sc.surface_flat:
-                score_air_up(sc, features, flux, radiance, w, ux, uy, uz, True, beam)
-                budget[BUDGET_WATER_LEAVING] += w
-                return events, n_stacked
-            r, cos_t = reflectance(sc, n, 1.0, -uz)
-            if sc.analog:
-                if np.random.random() >= r:
-                    ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, features, flux, radiance, w, ox, oy, oz, True, beam)
-                    budget[BUDGET_WATER_LEAVING] += w
-                    return events, n_stacked
-            else:
-                leaving = w * (1.0 - r)
-                if leaving > 0.0:
-                    ox, oy, oz = refract(ux, uy, uz, n, cos_t)
-                    score_air_up(sc, features, flux, radiance, leaving, ox, oy, oz, True,
-                                 beam)
-                    budget[BUDGET_WATER_LEAVING] += leaving
-                # the reflected part (expected weight w r) goes on by roulette: with
-                # probability r, carrying w, so its expectation is kept while a weak
-                # internally reflected packet costs no more than in an analog walk
-                if r < 1.0 and np.random.random() >= r:
-                    return events, n_stacked
-            uz = -uz
-            seg = 0
-            if level >= 0 and w > 0.0:
-                score(sc, features, flux, radiance, level, w, ux, uy, uz, beam)
-        elif target == bottom_plane:
-            if not features & FEATURE_BOTTOM:  # black (an infinitely deep bottom is never met)
-                budget[BUDGET_BOTTOM] += w
-                return events, n_stacked
-            if features & FEATURE_ESTIMATES:
-                if sc.local_estimates:
-                    local_estimate.score_bottom(sc, local, w, ux, uy, uz)
-                if sc.cap_estimates:
-                    local_estimate.cap_bottom(sc, cap, w, ux, uy, uz)
-            ux, uy, uz, rho = brdf.reflect(sc.bottom_model, sc.bottom_params, ux, uy, uz,
-                                           np.random.random(), np.random.random())
-            beam = beam and sc.bottom_model == BOTTOM_SPECULAR
-            if sc.analog:
-                if np.random.random() >= rho:
-                    budget[BUDGET_BOTTOM] += w
-                    return events, n_stacked
-            else:
-                budget[BUDGET_BOTTOM] += w * (1.0 - rho)
-                w *= rho
-            seg = bottom_plane - 1
-            if level >= 0 and w > 0.0:
-                score(sc, features, flux, radiance, level, w, ux, uy, uz, beam)
-            if features & FEATURE_SPLITTING and w > sc.split_weight:
-                w, n_stacked = split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam)
-        else:
-            seg = target if uz > 0.0 else target - 1
-            continue
-        alive, w = survives_roulette(sc, w)
+            alive = False
         if not alive:
-            return events, n_stacked
+            break
+    return events, n_stacked
 
 
-@njit(error_model="numpy", cache=True, _nrt=False)
-def trace_batch(sc, features, n_photons, seed, flux, radiance, local, cap, budget, stack):
-    """One batch: its own random stream (seeded from (seed, batch) by the caller), n_photons
-    packets whose weights add up to n_photons. The sky's share is stratified: round(f n) packets
-    come from the sky and carry f n / n_sky each, the rest from the sun; returns the number of
-    scattering events. A photon's split copies (stack) are traced before the next photon."""
+@njit(error_model="numpy", cache=True, nogil=True)
+def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
+                est_row, ef, ei, ctrl_row, n_photons, seed, tally, packet_row, stack):
+    """One batch: its own random stream (seeded from (seed, batch) by the caller; Numba's
+    generator state is per thread, and a batch runs in one thread), n_photons packets whose
+    weights add up to n_photons. The sky's share is stratified: round(f n) packets come from the
+    sky and carry f n / n_sky each, the rest from the sun; returns the number of scattering
+    events. A photon's split copies (stack) are traced before the next photon. The records come
+    as one-row arrays; the GIL is released, so batches run in parallel threads."""
+    medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
+    grid, est, ctrl, p = grid_row[0], est_row[0], ctrl_row[0], packet_row[0]
     np.random.seed(seed)
-    f = sc.diffuse_fraction
+    f = sky.diffuse_fraction
     if f <= 0.0:
         n_sky = 0
     elif f >= 1.0:
@@ -270,45 +344,37 @@ def trace_batch(sc, features, n_photons, seed, flux, radiance, local, cap, budge
     else:
         n_sky = min(n_photons - 1, max(1, int(round(f * n_photons))))
     w_sky = f * n_photons / n_sky if n_sky > 0 else 0.0
-    w_sun = (1.0 - f) * n_photons / (n_photons - n_sky) if n_sky < n_photons else 0.0
-    sun = (sc.sun_sin, 0.0, sc.sun_mu)
     n_sun = n_photons - n_sky
+    w_sun = (1.0 - f) * n_photons / n_sun if n_sun > 0 else 0.0
+    analog = ctrl.analog
     w_sun_in, sx, sy, sz = 0.0, 0.0, 0.0, 1.0
-    if not sc.analog and n_sun > 0:
+    if not analog and n_sun > 0:
         # every implicit-mode sun packet enters the same way: score the beam's entry once
-        _, w_sun_in, sx, sy, sz = enter_water(sc, features, w_sun * n_sun, sun[0], sun[1],
-                                              sun[2], True, flux, radiance, budget)
-        w_sun_in /= n_sun
+        launch(p, w_sun * n_sun, sky.sun_sin, 0.0, sky.sun_mu, 1)
+        enter_from_air(surface, ctrl, grid, gf, gi, tally, p)
+        w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
     events = 0
     for i in range(n_photons):
-        if features & FEATURE_SKY and i < n_sky:
-            ux, uy, uz, w = sky_direction(sc)
-            enters, w, ux, uy, uz = enter_water(sc, features, w * w_sky, ux, uy, uz, False,
-                                                flux, radiance, budget)
-            beam = False
-        elif sc.analog:
-            enters, w, ux, uy, uz = enter_water(sc, features, w_sun, sun[0], sun[1], sun[2],
-                                                True, flux, radiance, budget)
-            beam = True
+        from_air = True
+        if i < n_sky:
+            ux, uy, uz, weight = sky_direction(sky, sf)
+            launch(p, weight * w_sky, ux, uy, uz, 0)
+        elif analog:
+            launch(p, w_sun, sky.sun_sin, 0.0, sky.sun_mu, 1)
         else:
-            enters, w, ux, uy, uz, beam = True, w_sun_in, sx, sy, sz, True
-        if not enters:
+            launch(p, w_sun_in, sx, sy, sz, 1)
+            from_air = False
+        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
             continue
-        z, seg, n_stacked = 0.0, 0, 0
-        if features & FEATURE_SPLITTING and w > sc.split_weight:
-            w, n_stacked = split(sc, stack, n_stacked, z, seg, w, ux, uy, uz, beam)
+        n_stacked = 0
+        if ctrl.splitting and p.w > ctrl.split_weight:
+            n_stacked = split(ctrl, stack, n_stacked, p)
         while True:
-            traced, n_stacked = trace_in_water(sc, features, z, seg, w, ux, uy, uz, beam, flux,
-                                               radiance, local, cap, budget, stack, n_stacked)
+            traced, n_stacked = walk(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi,
+                                     est, ef, ei, tally, stack, n_stacked, p)
             events += traced
             if n_stacked == 0:
                 break
             n_stacked -= 1
-            z = stack[n_stacked, STACK_Z]
-            seg = int(stack[n_stacked, STACK_SEGMENT])
-            w = stack[n_stacked, STACK_WEIGHT]
-            ux = stack[n_stacked, STACK_UX]
-            uy = stack[n_stacked, STACK_UY]
-            uz = stack[n_stacked, STACK_UZ]
-            beam = stack[n_stacked, STACK_BEAM] > 0.5
+            copy_packet(p, stack[n_stacked])
     return events

@@ -13,7 +13,7 @@ thesis, 9.2, one-sample balance heuristic):
 which is w / (1 - f) outside the cone and at most w / (1 - f) anywhere. The expected weight
 times any function of the new direction is that of plain phase-function sampling, so every
 tally keeps its expectation. The caller has already multiplied w by the albedo w0, and
-f <= 1 - w0 (scene.py), so no scattering event makes a packet heavier: without that cap the
+f <= 1 - w0 (scene/medium.py), so no scattering event makes a packet heavier: without that cap the
 1 / (1 - f) per event outside the cone compounds over the long histories of turbid water
 (measured, w0 = 0.976, f = 0.1: Ed at 20 m lost 99% of its figure of merit).
 """
@@ -26,21 +26,22 @@ from .geometry import cos_sin_turn, turn
 from .phase import dispatch as phase
 
 
-@njit(error_model="numpy", cache=True, inline="always")
-def scatter(sc, layer, w, ux, uy, uz):
+@njit(error_model="numpy", cache=True)
+def scatter(medium, mf, mi, layer, w, ux, uy, uz):
     """(w, ux, uy, uz) after a scattering event in `layer` of a packet of weight w (already
     times the albedo) travelling (ux, uy, uz); up is -z."""
-    if np.random.random() < sc.layer_up_fraction[layer]:
-        mu = 1.0 - np.random.random() * (1.0 - sc.up_cos)
+    up_cos = medium.up_cos
+    if np.random.random() < mf[medium.up_fraction + layer]:
+        mu = 1.0 - np.random.random() * (1.0 - up_cos)
         sin_t = math.sqrt(max(0.0, 1.0 - mu * mu))
         cp, sp = cos_sin_turn(np.random.random())
         nx, ny, nz = sin_t * cp, sin_t * sp, -mu
     else:
-        u_pick = np.random.random() if sc.layer_comp_count[layer] > 1 else 0.0
-        cos_s = phase.sample_cos(sc, layer, u_pick, np.random.random())
+        u_pick = np.random.random() if mi[medium.comp_count + layer] > 1 else 0.0
+        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, np.random.random())
         nx, ny, nz = turn(ux, uy, uz, cos_s, np.random.random())
-    keep = sc.layer_up_keep[layer]
-    if -nz > sc.up_cos:
-        p = phase.evaluate(sc, layer, ux * nx + uy * ny + uz * nz)
-        return w * p / (keep * p + sc.layer_up_density[layer]), nx, ny, nz
+    keep = mf[medium.up_keep + layer]
+    if -nz > up_cos:
+        p = phase.evaluate(medium, mf, mi, layer, ux * nx + uy * ny + uz * nz)
+        return w * p / (keep * p + mf[medium.up_density + layer]), nx, ny, nz
     return w / keep, nx, ny, nz

@@ -29,7 +29,7 @@ import math
 from numba import njit
 
 from ..geometry import from_angles
-from ..interface import fresnel as fresnel_r
+from ..surface.fresnel import fresnel as fresnel_r
 
 
 @njit(error_model="numpy", cache=True)

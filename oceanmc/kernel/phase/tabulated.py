@@ -1,6 +1,7 @@
 """A tabulated phase function: nodes psi (rad), density q = 2 pi p sin(psi) piecewise linear
-between them, and its exact CDF (built in phase_tables.py). Sampling inverts the CDF exactly:
-within a node interval the CDF is quadratic in psi."""
+between them, and its exact CDF (built in scene/phase_tables.py), stored in a flat pool: the
+table's psi, q and cdf start at psi_at, q_at and cdf_at and have `length` nodes. Sampling inverts
+the CDF exactly: within a node interval the CDF is quadratic in psi."""
 import math
 
 from numba import njit
@@ -9,44 +10,48 @@ EDGE = 1e-12
 
 
 @njit(error_model="numpy", cache=True)
-def sample(psi, q, cdf, start, length, u):
-    lo = start
-    hi = start + length - 1
+def sample(pool, psi_at, q_at, cdf_at, length, u):
+    lo = 0
+    hi = length - 1
     while hi - lo > 1:  # cdf[lo] <= u < cdf[hi]
         mid = (lo + hi) >> 1
-        if cdf[mid] <= u:
+        if pool[cdf_at + mid] <= u:
             lo = mid
         else:
             hi = mid
-    need = u - cdf[lo]
-    q0 = q[lo]
-    slope = (q[lo + 1] - q0) / (psi[lo + 1] - psi[lo])
+    need = u - pool[cdf_at + lo]
+    q0 = pool[q_at + lo]
+    psi0 = pool[psi_at + lo]
+    psi1 = pool[psi_at + lo + 1]
+    slope = (pool[q_at + lo + 1] - q0) / (psi1 - psi0)
     disc = q0 * q0 + 2.0 * slope * need
     root = q0 + math.sqrt(max(0.0, disc))
     x = 2.0 * need / root if root > 0.0 else 0.0
-    angle = min(psi[lo + 1], psi[lo] + x)
+    angle = min(psi1, psi0 + x)
     return math.cos(angle)
 
 
 @njit(error_model="numpy", cache=True)
-def density(psi, q, start, length, angle):
+def density(pool, psi_at, q_at, length, angle):
     """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
     between nodes)."""
-    lo = start
-    hi = start + length - 1
+    lo = 0
+    hi = length - 1
     while hi - lo > 1:
         mid = (lo + hi) >> 1
-        if psi[mid] <= angle:
+        if pool[psi_at + mid] <= angle:
             lo = mid
         else:
             hi = mid
-    frac = (angle - psi[lo]) / (psi[lo + 1] - psi[lo])
-    return q[lo] + frac * (q[lo + 1] - q[lo])
+    psi0 = pool[psi_at + lo]
+    frac = (angle - psi0) / (pool[psi_at + lo + 1] - psi0)
+    q0 = pool[q_at + lo]
+    return q0 + frac * (pool[q_at + lo + 1] - q0)
 
 
 @njit(error_model="numpy", cache=True)
-def evaluate(psi, q, start, length, cos_psi):
+def evaluate(pool, psi_at, q_at, length, cos_psi):
     """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
     tends to a finite limit, taken by staying EDGE rad inside the range."""
     angle = min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
-    return density(psi, q, start, length, angle) / (2.0 * math.pi * math.sin(angle))
+    return density(pool, psi_at, q_at, length, angle) / (2.0 * math.pi * math.sin(angle))

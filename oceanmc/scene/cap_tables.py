@@ -94,12 +94,12 @@ def cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], beta: float, m
     return m0, m1 - mu_bar * m0
 
 
-def air_factor(mu_w: np.ndarray, n: float, flat: bool) -> np.ndarray:
-    """h(mu_w) = t(mu_w) / mu_a(mu_w) for the water-side directions of the air cap."""
-    from .kernel.interface import fresnel
-    if not flat:
-        return 1.0 / mu_w
+def air_factor(mu_w: np.ndarray, n: float, transmittance) -> np.ndarray:
+    """h(mu_w) = t(mu_w) / mu_a(mu_w) for the water-side directions of the air cap, with t the
+    surface's transmittance from the water (a function of the in-water cosine)."""
+    if n == 1.0:   # no refraction: mu_a = mu_w
+        return np.array([transmittance(float(m)) for m in mu_w]) / mu_w
     sin_a = np.sqrt(np.clip(1.0 - mu_w ** 2, 0.0, 1.0)) * n
     mu_a = np.sqrt(np.clip(1.0 - sin_a ** 2, 0.0, 1.0))
-    t = np.array([1.0 - fresnel(n, 1.0, float(m))[0] for m in mu_w])
+    t = np.array([transmittance(float(m)) for m in mu_w])
     return t / mu_a

@@ -1,9 +1,9 @@
-"""The flat air-water interface: exact unpolarized Fresnel reflectance and Snell refraction."""
+"""Fresnel reflectance and Snell refraction at a plane interface (shared by the surface models)."""
 import math
 
 from numba import njit
 
-from .geometry import renormalised
+from ..geometry import renormalised
 
 
 @njit(error_model="numpy", cache=True)
@@ -36,14 +36,6 @@ def schlick(n1, n2, cos_i):
     r0 = ((n1 - n2) / (n1 + n2)) ** 2
     c = cos_i if n1 <= n2 else cos_t
     return r0 + (1.0 - r0) * (1.0 - c) ** 5, cos_t
-
-
-@njit(error_model="numpy", cache=True, inline="always")
-def reflectance(sc, n1, n2, cos_i):
-    """(R, cos_t) with the scene's choice of formula."""
-    if sc.fresnel_schlick:
-        return schlick(n1, n2, cos_i)
-    return fresnel(n1, n2, cos_i)
 
 
 @njit(error_model="numpy", cache=True)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
-from .config import ConfigError
+from ..config import ConfigError
 
 
 class TableError(ConfigError):

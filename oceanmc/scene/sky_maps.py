@@ -71,8 +71,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import config as cfg
-from .kernel import models
+from .. import config as cfg
+from ..kernel import models
 from .phase_tables import TableError
 
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
@@ -324,29 +324,6 @@ def harrison_coombes_cells(sun_zenith_deg: float, n_t: int = HC_GRID[0], n_p: in
     return theta, phi, avg
 
 
-def sky_fields(ill: cfg.Illumination) -> dict:
-    """The SceneArrays sky fields for the configured sky."""
-    empty = {"sky_s_edges": np.zeros(2), "sky_phi_edges": np.zeros(2),
-             "sky_row_cdf": np.ones(1), "sky_cell_cdf": np.ones((1, 1)),
-             "sky_cell_L": np.ones((1, 1)), "sky_params": np.zeros(8)}
-    sky = ill.sky
-    if isinstance(sky, str) and sky in ("uniform", "cardioidal", "overcast"):
-        model = models.SKY_UNIFORM if sky == "uniform" else models.SKY_CARDIOIDAL
-        return dict(empty, sky_model=model)
-    if isinstance(sky, str):
-        assert sky == "harrison_coombes", sky
-        theta, phi, L = harrison_coombes_cells(ill.sun_zenith_deg)
-        model = models.SKY_HARRISON_COOMBES
-    else:
-        theta, phi, L = read_sky_map(sky.map, sky.dataset, sky.layout)
-        model = models.SKY_MAP if sky.sampling == "importance" else models.SKY_MAP_COSINE
-    tables = sampling_tables(theta, phi, L)
-    if model == models.SKY_MAP_COSINE:
-        # the cosine sampler uses only the edges; the cells hold its photon weights
-        tables["sky_cell_L"] = cosine_weights(tables["sky_s_edges"], tables["sky_phi_edges"], L)
-    return dict(tables, sky_model=model, sky_params=sky_parameters(ill.sun_zenith_deg))
-
-
 def cosine_weights(s_edges: np.ndarray, phi_edges: np.ndarray, L: np.ndarray) -> np.ndarray:
     """The weight L pi / E of a photon from each cell under cosine-weighted sampling (density
     cos / pi), E = integral of L cos dOmega over the map, on the sampler's own edges (sin^2 theta,
@@ -385,7 +362,7 @@ def sampling_tables(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray) -
         if rows[i] > 0.0:
             k = int(np.nonzero(mass[i] > 0.0)[0][-1])
             cell_cdf[i, k:] = 1.0
-    return {"sky_s_edges": s_edges, "sky_phi_edges": phi, "sky_row_cdf": row_cdf,
-            "sky_cell_cdf": np.ascontiguousarray(cell_cdf),
-            "sky_cell_L": np.ascontiguousarray(L.astype(np.float64))}
+    return {"s_edges": s_edges, "phi_edges": phi, "row_cdf": row_cdf,
+            "cell_cdf": np.ascontiguousarray(cell_cdf),
+            "cell_l": np.ascontiguousarray(L.astype(np.float64))}
 

@@ -36,10 +36,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import config as cfg
-from .config import ConfigError
-from .kernel import models
-from .kernel.brdf import tables as ktables
+from .. import config as cfg
+from ..config import ConfigError
+from ..kernel import models
+from ..kernel.brdf import tables as ktables
 from .phase_tables import TableError, numeric_rows
 
 ENERGY_TOLERANCE = 1e-3

@@ -1,0 +1,143 @@
+"""The scene as the compiled code sees it: one narrow record per component, and flat pools.
+
+Each component (medium, surface, bottom, sky, tally grid, local estimates, estimator) is one
+numpy structured scalar of a fixed dtype below, passed to the kernel as a one-row array. Its
+scalar fields are read directly; its tables live in the component's flat pools (float64, and
+int64 where needed), and the record holds their offsets: a field named like a table (plane_z,
+layer_c, ...) is the offset of that table in the pool. So every scene, whatever its number of
+layers, tables or tally depths, has the same types, and each compiled function is compiled once
+(MC/DC's records plus one flat data array, CEMeNT-PSAAP/MCDC).
+
+The packet is a record too (PACKET); the split stack holds rows of the same dtype.
+
+The tallies of one batch are one flat float64 row; the GRID record holds where each score's
+array starts (flux, radiance, local, cap, budget) and its shape.
+
+Nothing here is compiled: the packers (oceanmc/scene/) fill these, the kernel reads them.
+"""
+import numpy as np
+
+I8 = np.int64
+F8 = np.float64
+
+
+def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
+    return np.dtype([(name, I8 if name in ints else F8) for name in fields], align=True)
+
+
+# Water column: planes (surface first, then layer boundaries and tally depths, bottom last; z =
+# inf below an infinitely deep last layer), the segments between them, the layers, the phase
+# function components of each layer and their tables, and the upward bias per layer.
+#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo, up_fraction,
+#               up_density, up_keep (n_layers); comp_cumweight (n_comps), comp_params (2 each);
+#               tab_psi, tab_q, tab_cdf (all tables, each component at its tab_start)
+#   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
+#               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len
+MEDIUM = _record(
+    "n_planes", "n_layers", "up_cos",
+    "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
+    "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
+    "tab_psi", "tab_q", "tab_cdf",
+    "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
+    "comp_tab_start", "comp_tab_len",
+    ints=("n_planes", "n_layers", "plane_z", "plane_tau", "layer_c", "layer_inv_c",
+          "layer_albedo", "up_fraction", "up_density", "up_keep", "comp_cumweight",
+          "comp_params", "tab_psi", "tab_q", "tab_cdf", "plane_tally", "segment_layer",
+          "comp_start", "comp_count", "comp_model", "comp_tab_start", "comp_tab_len"))
+
+# The air-water surface (kernel/surface/): model id and its parameters.
+SURFACE = _record("model", "n_water", "schlick", ints=("model", "schlick"))
+
+# The bottom (kernel/brdf/): model id; its parameters are the bottom pool (brdf_tables layout).
+BOTTOM = _record("model", "reflects", "mirror", ints=("model", "reflects", "mirror"))
+
+# Sun and sky (kernel/sources.py).
+#   float pool: s_edges (n_rows + 1; sin^2 of the view zenith), phi_edges (n_cols + 1; rad),
+#               row_cdf (n_rows), cell_cdf and cell_l (n_rows x n_cols, row-major), params (8)
+SKY = _record(
+    "sun_mu", "sun_sin", "diffuse_fraction", "model", "n_rows", "n_cols",
+    "s_edges", "phi_edges", "row_cdf", "cell_cdf", "cell_l", "params",
+    ints=("model", "n_rows", "n_cols", "s_edges", "phi_edges", "row_cdf", "cell_cdf",
+          "cell_l", "params"))
+
+# Tally grid and the layout of one batch's tally row (kernel/tally.py).
+#   levels: the in-water tally depths (n_depths), then air (0+, all light), then air_leaving
+#   (0+, water-leaving light only).
+#   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
+#               phi_edge_sin (n_phi), level_z, level_tau (n_depths)
+#   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
+#   tally row:  flux (n_levels x 4), radiance (n_levels x n_theta_cols x n_phi_cols),
+#               local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget (n_budget)
+GRID = _record(
+    "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
+    "n_lookup", "theta_cols", "phi_cols",
+    "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
+    "theta_lookup", "theta_is_cap",
+    "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
+    ints=("n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
+          "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
+          "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",
+          "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size"))
+
+# Local (next-event) estimates (kernel/local_estimate.py): exact upward directions, and the
+# nadir polar-cap average (tables from scene/estimates.py).
+#   float pool: dirs (n_dirs x 3), air_factor (n_dirs), cap_m0w, cap_m1w, cap_m0a, cap_m1a
+#               (n_tables x n_alpha each), level_decay (n_depths)
+#   int pool:   in_water (n_dirs), table_of_layer (n_layers)
+ESTIMATES = _record(
+    "directions_on", "cap_on", "n_dirs", "n_alpha",
+    "fine_end", "fine_step", "coarse_step", "fine_nodes",
+    "mu_w", "omega_w", "cos_water", "mu_a", "omega_a", "cos_air", "h", "dh",
+    "dirs", "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay",
+    "in_water", "table_of_layer",
+    ints=("directions_on", "cap_on", "n_dirs", "n_alpha", "fine_nodes", "dirs",
+          "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay",
+          "in_water", "table_of_layer"))
+
+# How weights evolve (kernel/transport.py).
+ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",
+                    "split_weight", "splitting", "upward",
+                    ints=("analog", "max_events", "splitting", "upward"))
+
+# A photon packet: position (depth z and the segment it is in or on), weight, direction of
+# travel, whether it still belongs to the collimated solar beam, and its wavelength's index.
+PACKET = np.dtype([("z", F8), ("w", F8), ("ux", F8), ("uy", F8), ("uz", F8), ("seg", I8),
+                   ("beam", I8), ("wavelength", I8)], align=True)
+
+# Rows on the split stack of one batch (kernel/transport.py)
+SPLIT_STACK_ROWS = 64
+
+
+def record(dtype: np.dtype, **values) -> np.ndarray:
+    """A one-row array of the record dtype with the given fields (the rest 0); every field of
+    the dtype must be named, so a packer cannot forget one."""
+    missing = set(dtype.names) - set(values)
+    unknown = set(values) - set(dtype.names)
+    if missing or unknown:
+        raise ValueError(f"record fields missing {sorted(missing)}, unknown {sorted(unknown)}")
+    out = np.zeros(1, dtype=dtype)
+    for name, value in values.items():
+        out[name][0] = value
+    return out
+
+
+class Pool:
+    """A flat pool being filled: add(array) appends it and returns its offset."""
+
+    def __init__(self, dtype) -> None:
+        self.dtype = dtype
+        self.parts: list[np.ndarray] = []
+        self.size = 0
+
+    def add(self, values) -> int:
+        values = np.ascontiguousarray(values, dtype=self.dtype).ravel()
+        offset = self.size
+        self.parts.append(values)
+        self.size += values.size
+        return offset
+
+    def array(self) -> np.ndarray:
+        """The pool (one element at least, so that an empty pool is still an array)."""
+        if not self.parts:
+            return np.zeros(1, dtype=self.dtype)
+        return np.concatenate(self.parts + [np.zeros(1, dtype=self.dtype)])

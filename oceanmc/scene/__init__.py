@@ -1,0 +1,79 @@
+"""Config -> the kernel's records and pools: one packer per component (medium, surface, bottom,
+sky, tally grid, local estimates), each producing its record (kernel/records.py), in one pass.
+No Python object crosses into the kernel."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config as cfg
+from ..kernel.records import ESTIMATOR, record
+from . import bottom, estimates, grid, medium, sky, surface
+from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """The packed scene: records (one-row arrays of the kernel/records.py dtypes) and pools, in
+    the order the photon loop takes them (kernel_args), the angular grid, and for each requested
+    local direction its (water row, air row)."""
+    medium: np.ndarray
+    mf: np.ndarray
+    mi: np.ndarray
+    surface: np.ndarray
+    bottom: np.ndarray
+    bp: np.ndarray
+    sky: np.ndarray
+    sf: np.ndarray
+    grid: np.ndarray
+    gf: np.ndarray
+    gi: np.ndarray
+    estimates: np.ndarray
+    ef: np.ndarray
+    ei: np.ndarray
+    estimator: np.ndarray
+    angles: Grid
+    local_rows: list
+
+    def kernel_args(self) -> tuple:
+        return (self.medium, self.mf, self.mi, self.surface, self.bottom, self.bp, self.sky,
+                self.sf, self.grid, self.gf, self.gi, self.estimates, self.ef, self.ei,
+                self.estimator)
+
+    @property
+    def tally_size(self) -> int:
+        return int(self.grid[0]["size"])
+
+    @property
+    def splitting(self) -> bool:
+        return bool(self.estimator[0]["splitting"])
+
+
+def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
+    upward = medium.upward_fractions(est, albedo)
+    return record(ESTIMATOR, analog=int(est.mode == "analog"),
+                  roulette_weight=float(est.roulette_weight),
+                  roulette_survival=float(est.roulette_survival),
+                  max_events=int(est.max_events),
+                  split_weight=float(est.split_weight or np.inf),
+                  splitting=int(est.split_weight is not None),
+                  upward=int(upward.max(initial=0.0) > 0.0))
+
+
+def build(config: cfg.SceneConfig) -> Scene:
+    """The kernel's view of a validated scene. Raises TableError (a ConfigError) for unusable
+    auxiliary files."""
+    med, mf, mi, column = medium.pack(config)
+    surf = surface.pack(config.surface, config.n_water)
+    bot, bp = bottom.pack(config.bottom)
+    sk, sf = sky.pack(config.illumination)
+    *directions, local_rows = estimates.local_directions(config, surf)
+    gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
+                                   len(directions[0]))
+    est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
+    return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
+                 pack_estimator(config.estimator, column.albedo), angles, local_rows)
+
+
+__all__ = ["Scene", "Grid", "build", "make_grid"]

@@ -1,0 +1,129 @@
+"""The local-estimate packer: the ESTIMATES record and its pools (kernel/records.py): the rows
+of the exact upward directions, and the tables of the nadir polar-cap estimate (cap_tables.py)
+for each distinct layer phase function."""
+from __future__ import annotations
+
+import hashlib
+import math
+
+import numpy as np
+
+from .. import config as cfg
+from ..kernel.phase.dispatch import layer_density
+from ..kernel.records import ESTIMATES, Pool, record
+from ..kernel.surface.dispatch import transmittance
+from . import cap_tables
+from .grid import Grid
+from .medium import Column
+
+
+def local_directions(config: cfg.SceneConfig, surface: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple[int, int]]]:
+    """Kernel rows for the requested local-estimate directions (theta, phi of travel; in water at
+    the tally depths, in air at 0+): unit in-water directions, whether a row scores the water
+    levels, its factor t/n^2 at 0+ (0: not scored there; t from the surface component), and for
+    each requested direction its (water row, air row)."""
+    n = config.n_water
+    dirs, water, air, rows = [], [], [], []
+    for theta_deg, phi_deg in config.tallies.local_directions_deg:
+        theta, phi = math.radians(theta_deg), math.radians(phi_deg)
+        in_water = (math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi),
+                    math.cos(theta))
+        sin_w = math.sin(theta) / n               # Snell: the in-water direction seen at 0+
+        cos_w = math.sqrt(1.0 - sin_w * sin_w)
+        refracted = (sin_w * math.cos(phi), sin_w * math.sin(phi), -cos_w)
+        factor = transmittance(surface[0], cos_w) / (n * n)
+        if np.allclose(in_water, refracted, atol=1e-15):
+            rows.append((len(dirs), len(dirs)))
+            dirs.append(in_water), water.append(True), air.append(factor)
+        else:
+            rows.append((len(dirs), len(dirs) + 1))
+            dirs += [in_water, refracted]
+            water += [True, False]
+            air += [0.0, factor]
+    return (np.array(dirs, dtype=np.float64).reshape(-1, 3), np.array(water, dtype=np.int64),
+            np.array(air, dtype=np.float64), rows)
+
+
+_CAP_CACHE: dict[bytes, list[np.ndarray]] = {}
+
+
+def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) -> bytes:
+    """A digest of the layer's phase function: its components' models, weights, parameters and
+    tables."""
+    m = medium[0]
+    first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
+    digest = hashlib.sha1()
+    for k in range(first, first + count):
+        start, length = mi[m["comp_tab_start"] + k], mi[m["comp_tab_len"] + k]
+        digest.update(np.array([mi[m["comp_model"] + k], mf[m["comp_cumweight"] + k],
+                                mf[m["comp_params"] + 2 * k], mf[m["comp_params"] + 2 * k + 1]])
+                      .tobytes())
+        digest.update(mf[m["tab_q"] + start:m["tab_q"] + start + length].tobytes())
+        digest.update(mf[m["tab_psi"] + start:m["tab_psi"] + start + length].tobytes())
+    return digest.digest()
+
+
+def layer_cap_moments(medium, mf, mi, layer: int, geometry: tuple, alphas: np.ndarray
+                      ) -> list[np.ndarray]:
+    """[M0, M1] of the water cap and of the air cap's water side for one layer's phase function,
+    remembered within the process by the phase function's content (scenes of a batch, tests)."""
+    key = hashlib.sha1(np.array(geometry).tobytes() + layer_key(medium, mf, mi, layer)).digest()
+    if key not in _CAP_CACHE:
+        m = medium[0]
+        first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
+        breaks = np.concatenate(
+            [mf[m["tab_psi"] + mi[m["comp_tab_start"] + k]:
+                m["tab_psi"] + mi[m["comp_tab_start"] + k] + mi[m["comp_tab_len"] + k]]
+             for k in range(first, first + count)] + [np.zeros(0)])
+        beta, mu_w, beta_w, mu_a = geometry
+        table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, psi), breaks)
+        _CAP_CACHE[key] = [*cap_tables.cap_moments(table, beta, mu_w, alphas),
+                           *cap_tables.cap_moments(table, beta_w, mu_a, alphas)]
+        if len(_CAP_CACHE) > 64:
+            _CAP_CACHE.pop(next(iter(_CAP_CACHE)))
+    return _CAP_CACHE[key]
+
+
+def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.ndarray,
+         surface: np.ndarray, column: Column, grid: Grid,
+         directions: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ESTIMATES record, float pool, int pool); directions: local_directions' first three."""
+    dirs, in_water, air_factor = directions
+    beta = math.radians(180.0 - grid.theta_edges[-2])
+    n = config.n_water
+    beta_w = math.asin(math.sin(beta) / n)
+    mu_w = 0.5 * (1.0 + math.cos(beta))
+    mu_a = 0.5 * (1.0 + math.cos(beta_w))
+    fine_end, fine_step, coarse_step, fine_nodes = cap_tables.alpha_grid(beta)
+    alphas = cap_tables.alpha_nodes(beta)
+    enabled = config.nadir_local
+    tables: dict[bytes, int] = {}
+    table_of_layer = []
+    moments = {"m0w": [], "m1w": [], "m0a": [], "m1a": []}
+    for layer in range(len(config.water.layers)):
+        key = layer_key(medium, mf, mi, layer) if enabled else b""
+        if key not in tables:
+            tables[key] = len(tables)
+            values = layer_cap_moments(medium, mf, mi, layer, (beta, mu_w, beta_w, mu_a),
+                                       alphas) if enabled else [np.zeros(len(alphas))] * 4
+            for name, v in zip(moments, values):
+                moments[name].append(v)
+        table_of_layer.append(tables[key])
+    step = 1e-6
+    h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
+                              lambda mu: transmittance(surface[0], mu))
+    f, i = Pool(np.float64), Pool(np.int64)
+    level_tau = column.level_tau
+    rec = record(
+        ESTIMATES, directions_on=int(len(dirs) > 0), cap_on=int(enabled), n_dirs=len(dirs),
+        n_alpha=len(alphas), fine_end=fine_end, fine_step=fine_step, coarse_step=coarse_step,
+        fine_nodes=int(fine_nodes), mu_w=mu_w, omega_w=2.0 * math.pi * (1.0 - math.cos(beta)),
+        cos_water=math.cos(beta), mu_a=mu_a, omega_a=2.0 * math.pi * (1.0 - math.cos(beta)),
+        cos_air=math.cos(beta), h=float(h[1]), dh=float((h[2] - h[0]) / (2.0 * step)),
+        dirs=f.add(dirs), air_factor=f.add(air_factor),
+        **{f"cap_{name}": f.add(np.array(v)) for name, v in moments.items()},
+        # transmission along mu_w from each level to the one above it (the first: unused)
+        level_decay=f.add(np.exp(-np.diff(level_tau, prepend=level_tau[:1]) / mu_w)),
+        in_water=i.add(in_water), table_of_layer=i.add(table_of_layer))
+    return rec, f.array(), i.array()

@@ -1,0 +1,119 @@
+"""The tally-grid packer: the angular grid of the radiance tallies, the GRID record and its
+pools (kernel/records.py), and the layout of one batch's flat tally row."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config as cfg
+from ..kernel import models
+from ..kernel.records import GRID, Pool, record
+
+THETA_LOOKUP_CELLS = 4096
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The angular grid of the radiance tallies (deg). Bands touching a pole are polar caps,
+    not split in azimuth (HydroLight's quads)."""
+    theta_edges: np.ndarray
+    phi_edges: np.ndarray
+    is_cap: np.ndarray
+
+    @property
+    def theta(self) -> np.ndarray:
+        return 0.5 * (self.theta_edges[1:] + self.theta_edges[:-1])
+
+    @property
+    def phi(self) -> np.ndarray:
+        return 0.5 * (self.phi_edges[1:] + self.phi_edges[:-1])
+
+    @property
+    def solid_angle(self) -> np.ndarray:
+        """(theta, phi) quad solid angles in sr; a cap's full solid angle in every phi column."""
+        mu = np.cos(np.radians(self.theta_edges))
+        band = np.abs(mu[:-1] - mu[1:])
+        dphi = np.radians(np.diff(self.phi_edges))
+        omega = band[:, None] * dphi[None, :]
+        omega[self.is_cap, :] = 2.0 * math.pi * band[self.is_cap, None]
+        return omega
+
+
+def make_grid(tallies: cfg.Tallies) -> Grid:
+    edges = np.array(tallies.theta_edges, dtype=np.float64)
+    n = tallies.phi_bands
+    step = 360.0 / n
+    phi_edges = -0.5 * step + step * np.arange(n + 1)
+    is_cap = np.zeros(len(edges) - 1, dtype=np.bool_)
+    is_cap[0] = True
+    is_cap[-1] = True
+    return Grid(edges, phi_edges, is_cap)
+
+
+def mu_edges(theta_edges: np.ndarray) -> np.ndarray:
+    mu = np.cos(np.radians(theta_edges))
+    mu[theta_edges == 90.0] = 0.0  # exact, so no downward photon lands in an upward band
+    return mu
+
+
+def theta_lookup(mu: np.ndarray) -> np.ndarray:
+    """For each of THETA_LOOKUP_CELLS equal cells of uz in [-1, 1], the band (index into the
+    falling mu edges) of the cell's top value (see kernel.tally.theta_band_fast)."""
+    top = -1.0 + 2.0 * (np.arange(THETA_LOOKUP_CELLS) + 1) / THETA_LOOKUP_CELLS
+    top = np.minimum(top, 1.0)
+    bands = np.searchsorted(-mu, -top, side="left") - 1
+    return np.clip(bands, 0, len(mu) - 2).astype(np.int64)
+
+
+def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
+         surface_level: int, n_dirs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
+    """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
+    light), then 0+ (water-leaving light); n_dirs local-estimate rows."""
+    grid = make_grid(config.tallies)
+    mu = mu_edges(grid.theta_edges)
+    n_depths = len(depths)
+    n_levels = n_depths + 2
+    radiance_on = bool(config.tallies.radiance)
+    theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
+    n_budget = models.BUDGET_LAYERS + len(config.water.layers)
+    layout = {}
+    size = 0
+    for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
+                         ("local", (n_depths + 1) * n_dirs), ("cap", n_depths + 1),
+                         ("budget", n_budget)):
+        layout[name] = size
+        size += length
+    f, i = Pool(np.float64), Pool(np.int64)
+    rec = record(
+        GRID, n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
+        mu_cut=float(config.tallies.grazing_mu_cut), radiance_on=int(radiance_on),
+        n_theta=len(grid.theta), n_phi=int(config.tallies.phi_bands),
+        n_lookup=THETA_LOOKUP_CELLS, theta_cols=theta_cols, phi_cols=phi_cols,
+        theta_mu_edges=f.add(mu), phi_edge_cos=f.add(np.cos(np.radians(grid.phi_edges[:-1]))),
+        phi_edge_sin=f.add(np.sin(np.radians(grid.phi_edges[:-1]))),
+        level_z=f.add(depths), level_tau=f.add(level_tau),
+        theta_lookup=i.add(theta_lookup(mu)), theta_is_cap=i.add(grid.is_cap),
+        n_dirs=n_dirs, n_budget=n_budget, size=size, **layout)
+    return rec, f.array(), i.array(), grid
+
+
+def tally_views(grid_record: np.ndarray, tallies: np.ndarray) -> dict[str, np.ndarray]:
+    """The per-batch tally rows (batch, size) as named arrays with a batch axis first: flux
+    (level, 4), radiance (level, theta, phi), local (level, direction), cap (level), budget."""
+    g = grid_record[0]
+    nb = tallies.shape[0]
+    n_levels = int(g["n_depths"]) + 2
+
+    def part(name, length, shape):
+        at = int(g[name])
+        return tallies[:, at:at + length].reshape((nb,) + shape)
+
+    n_dirs = int(g["n_dirs"])
+    rad = (n_levels, int(g["theta_cols"]), int(g["phi_cols"]))
+    return {"flux": part("flux", 4 * n_levels, (n_levels, 4)),
+            "radiance": part("radiance", int(np.prod(rad)), rad),
+            "local": part("local", (n_levels - 1) * n_dirs, (n_levels - 1, n_dirs)),
+            "cap": part("cap", n_levels - 1, (n_levels - 1,)),
+            "budget": part("budget", int(g["n_budget"]), (int(g["n_budget"]),))}

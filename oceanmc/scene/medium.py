@@ -1,0 +1,161 @@
+"""The water-column packer: the MEDIUM record and its pools (kernel/records.py): planes and
+segments, per-layer optical properties, the phase-function components of each layer and their
+tables, and the per-layer upward-bias fractions."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import config as cfg
+from ..kernel import models
+from ..kernel.records import MEDIUM, Pool, record
+from . import phase_tables
+
+PURE_WATER_BETA = 0.835   # 0.06225 (1 + 0.835 cos^2): Morel (1974)
+RAYLEIGH_BETA = 1.0
+
+
+@dataclass(frozen=True)
+class Column:
+    """What the other packers need to know of the water column."""
+    plane_z: np.ndarray        # plane depths: surface first, bottom (or inf) last
+    plane_tau: np.ndarray      # optical depth of each plane
+    surface_level: int         # the tally level at 0- (or -1)
+    depths: np.ndarray         # tally depths, snapped onto layer boundaries
+    level_tau: np.ndarray      # optical depth of each tally depth
+    albedo: np.ndarray         # per layer
+
+
+def phase_components(phase) -> list[tuple[float, int, list[float], tuple | None]]:
+    """(relative weight, model id, params, table) for each component of a layer's phase."""
+    if isinstance(phase, cfg.Mixture):
+        total = sum(c.b for c in phase.components)
+        out = []
+        for comp in phase.components:
+            share = comp.b / total if total > 0.0 else 1.0 / len(phase.components)
+            out += [(share * w, m, p, t) for w, m, p, t in phase_components(comp.phase)]
+        return out
+    if isinstance(phase, cfg.Isotropic):
+        return [(1.0, models.PHASE_ISOTROPIC, [], None)]
+    if isinstance(phase, cfg.Rayleigh):
+        return [(1.0, models.PHASE_QUADRATIC, [RAYLEIGH_BETA], None)]
+    if isinstance(phase, cfg.PureWater):
+        return [(1.0, models.PHASE_QUADRATIC, [PURE_WATER_BETA], None)]
+    if isinstance(phase, cfg.HenyeyGreenstein):
+        return [(1.0, models.PHASE_HG, [phase.g], None)]
+    if isinstance(phase, cfg.TwoTermHG):
+        return [(phase.alpha, models.PHASE_HG, [phase.g1], None),
+                (1.0 - phase.alpha, models.PHASE_HG, [phase.g2], None)]
+    if isinstance(phase, cfg.FournierForand):
+        return [(1.0, models.PHASE_TABULATED, [],
+                 phase_tables.fournier_forand_table(phase.bb_ratio))]
+    if isinstance(phase, cfg.Petzold):
+        return [(1.0, models.PHASE_TABULATED, [], phase_tables.petzold_table())]
+    if isinstance(phase, cfg.TablePhase):
+        return [(1.0, models.PHASE_TABULATED, [], phase_tables.user_table(phase.file))]
+    raise AssertionError(f"unhandled phase model {phase!r}")
+
+
+def planes(config: cfg.SceneConfig):
+    """Plane depths (surface first, bottom or inf last), the tally level at each plane (-1 for
+    none), the layer of each segment between planes, the level tallied at 0- (or -1), and the
+    tally depths (snapped onto layer boundaries they differ from only by rounding)."""
+    bounds = [0.0]
+    for layer in config.water.layers:
+        bounds.append(bounds[-1] + layer.thickness_m)
+    # a tally depth that differs from a layer boundary only by rounding (the sum of many thin
+    # layers) is that boundary, not a sliver of a segment beside it
+    edges = np.array(bounds)
+    depths = []
+    for d in config.tallies.depths_m:
+        near = int(np.argmin(np.abs(edges - d)))
+        depths.append(bounds[near] if abs(edges[near] - d) <= 1e-9 * max(1.0, d) else d)
+    plane_z = np.array(sorted(set(bounds) | set(depths)), dtype=np.float64)
+    level_of = {d: i for i, d in enumerate(depths)}
+    plane_tally = np.array([level_of.get(z, -1) for z in plane_z], dtype=np.int64)
+    tops = np.array(bounds[:-1])
+    mids = np.where(np.isinf(plane_z[1:]), plane_z[:-1] + 1.0, 0.5 * (plane_z[1:] + plane_z[:-1]))
+    segment_layer = (np.searchsorted(tops, mids, side="right") - 1).astype(np.int64)
+    return plane_z, plane_tally, segment_layer, int(plane_tally[0]), np.array(depths)
+
+
+def optical_depths(plane_z: np.ndarray, segment_layer: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """tau = integral of c dz from the surface to each plane (inf below an infinite layer)."""
+    with np.errstate(invalid="ignore"):
+        steps = np.where(np.isinf(plane_z[1:]), np.inf,
+                         c[segment_layer] * (plane_z[1:] - plane_z[:-1]))
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
+    """Scattering biased toward straight up (kernel/upward.py): a layer's fraction is at most
+    1 - w0, so that no scattering event makes a packet heavier; 0 in a layer leaves it out."""
+    fraction = np.minimum(float(estimator.upward_fraction or 0.0), 1.0 - albedo)
+    fraction[albedo <= 0.0] = 0.0
+    return fraction
+
+
+def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
+    """(MEDIUM record, float pool, int pool, Column)."""
+    layers = config.water.layers
+    comp_start, comp_count, cumweight, comp_model, comp_params = [], [], [], [], []
+    tab_start, tab_len, psi_parts, q_parts, cdf_parts = [], [], [], [], []
+    tab_offset = 0
+    table_at: dict[int, tuple[int, int]] = {}
+    for layer in layers:
+        comps = phase_components(layer.phase)
+        comp_start.append(len(comp_model))
+        comp_count.append(len(comps))
+        total = sum(w for w, *_ in comps)
+        running = 0.0
+        for weight, model, params, table in comps:
+            running += weight / total
+            cumweight.append(running)
+            comp_model.append(model)
+            comp_params.append(list(params) + [0.0] * (2 - len(params)))
+            if table is None:
+                tab_start.append(0)
+                tab_len.append(0)
+                continue
+            key = id(table[0])
+            if key not in table_at:
+                table_at[key] = (tab_offset, len(table[0]))
+                psi_parts.append(table[0])
+                q_parts.append(table[1])
+                cdf_parts.append(table[2])
+                tab_offset += len(table[0])
+            tab_start.append(table_at[key][0])
+            tab_len.append(table_at[key][1])
+        cumweight[-1] = 1.0
+
+    plane_z, plane_tally, segment_layer, surface_level, depths = planes(config)
+    layer_c = np.array([layer.a + layer.b for layer in layers], dtype=np.float64)
+    albedo = np.array([layer.b / (layer.a + layer.b) if layer.b > 0.0 else 0.0
+                       for layer in layers], dtype=np.float64)
+    plane_tau = optical_depths(plane_z, segment_layer, layer_c)
+    level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
+                         dtype=np.float64)
+    fraction = upward_fractions(config.estimator, albedo)
+    up_cos = math.cos(math.radians(config.estimator.upward_cone_deg))
+
+    f, i = Pool(np.float64), Pool(np.int64)
+    rec = record(
+        MEDIUM, n_planes=len(plane_z), n_layers=len(layers), up_cos=up_cos,
+        plane_z=f.add(plane_z), plane_tau=f.add(plane_tau), layer_c=f.add(layer_c),
+        layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
+                                    where=layer_c > 0.0)),
+        layer_albedo=f.add(albedo), up_fraction=f.add(fraction),
+        up_density=f.add(fraction / (2.0 * math.pi * (1.0 - up_cos))),
+        up_keep=f.add(1.0 - fraction), comp_cumweight=f.add(cumweight),
+        comp_params=f.add(comp_params),
+        tab_psi=f.add(np.concatenate(psi_parts) if psi_parts else np.zeros(0)),
+        tab_q=f.add(np.concatenate(q_parts) if q_parts else np.zeros(0)),
+        tab_cdf=f.add(np.concatenate(cdf_parts) if cdf_parts else np.zeros(0)),
+        plane_tally=i.add(plane_tally), segment_layer=i.add(segment_layer),
+        comp_start=i.add(comp_start), comp_count=i.add(comp_count),
+        comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
+        comp_tab_len=i.add(tab_len))
+    column = Column(plane_z, plane_tau, surface_level, depths, level_tau, albedo)
+    return rec, f.array(), i.array(), column
