@@ -184,7 +184,7 @@ def assert_chi2(observed, probabilities, *, p_min: float = 1e-4, rel_cap: float 
 
 def fresnel_reference(n1: float, n2: float, theta_i: float) -> float:
     """Unpolarized Fresnel reflectance in the sine/tangent form (Born & Wolf 1.5.3, Eqs. 35a-b),
-    written independently of oceanmc.kernel.interface (which uses the cosine form)."""
+    written independently of oceanmc.kernel.surface.fresnel (which uses the cosine form)."""
     s = n1 / n2 * math.sin(theta_i)
     if s >= 1.0:
         return 1.0

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import oceanmc
-from oceanmc import brdf_tables
+from oceanmc.scene import brdf_tables
 from oceanmc.config import ConfigError, load_config
 from oceanmc.kernel import models
 from oceanmc.kernel.brdf import tables as kt

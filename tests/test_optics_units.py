@@ -8,8 +8,9 @@ from scipy import integrate
 
 import oceanmc
 from oceanmc import scene
+from oceanmc.kernel import models
 from oceanmc.kernel.geometry import cos_sin_turn, from_angles, turn
-from oceanmc.kernel.interface import fresnel, refract
+from oceanmc.kernel.surface.fresnel import fresnel, refract
 
 from stats_helpers import fresnel_reference
 
@@ -172,9 +173,9 @@ def test_diffuse_reflectance_monte_carlo():
 def test_schlick_is_not_the_default():
     config = oceanmc.load_config({"water": {"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 0.0}]},
                                   "bottom": {"model": "black"}})
-    sc, _ = scene.build(config)
-    assert not sc.fresnel_schlick
-    assert sc.surface_flat and sc.n_water == 1.34
+    surface = scene.build(config).surface[0]
+    assert not surface["schlick"]
+    assert surface["model"] == models.SURFACE_FLAT and surface["n_water"] == 1.34
 
 
 # --- direction geometry ----------------------------------------------------------------------

@@ -15,7 +15,8 @@ from numba import njit
 from scipy import integrate, optimize
 
 import oceanmc
-from oceanmc import phase_tables, scene
+from oceanmc import scene
+from oceanmc.scene import phase_tables
 from oceanmc.kernel.phase import dispatch
 
 from stats_helpers import assert_chi2, assert_z
@@ -25,17 +26,19 @@ N_SAMPLES = 400_000
 
 @njit(cache=False)
 def _draw(sc, layer, u_pick, u):
+    medium, mf, mi = sc
     out = np.empty(u.shape[0])
     for i in range(u.shape[0]):
-        out[i] = dispatch.sample_cos(sc, layer, u_pick[i], u[i])
+        out[i] = dispatch.sample_cos(medium[0], mf, mi, layer, u_pick[i], u[i])
     return out
 
 
 @njit(cache=False)
 def _evaluate(sc, layer, mu):
+    medium, mf, mi = sc
     out = np.empty(mu.shape[0])
     for i in range(mu.shape[0]):
-        out[i] = dispatch.evaluate(sc, layer, mu[i])
+        out[i] = dispatch.evaluate(medium[0], mf, mi, layer, mu[i])
     return out
 
 
@@ -44,7 +47,8 @@ def scene_arrays(phase: dict, b: float = 1.0):
     if phase["model"] != "mixture":
         layer["b"] = b   # a mixture's b is the sum of its components'
     config = oceanmc.load_config({"water": {"layers": [layer]}, "bottom": {"model": "black"}})
-    return scene.build(config)[0]
+    built = scene.build(config)
+    return built.medium, built.mf, built.mi
 
 
 def sample(phase: dict, n: int = N_SAMPLES, seed: int = 1) -> np.ndarray:

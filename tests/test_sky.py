@@ -30,7 +30,9 @@ import OpenEXR
 import pytest
 
 import oceanmc
-from oceanmc import scene, sky_maps
+from oceanmc import scene
+from oceanmc.scene import sky as sky_packer
+from oceanmc.scene import sky_maps
 from oceanmc.config import ConfigError, load_config
 from oceanmc.kernel.sources import sky_many
 
@@ -55,8 +57,8 @@ def base(sky, **over):
 
 
 def draw(sky, n, seed=1, **over):
-    sc, _ = scene.build(load_config(base(sky, **over)))
-    return sky_many(sc, n, seed)
+    sc = scene.build(load_config(base(sky, **over)))
+    return sky_many(sc.sky, sc.sf, n, seed)
 
 
 def view_angles(u):
@@ -135,15 +137,17 @@ def test_cosine_map_sampling(tmp_path):
     and the weights average to 1 (exactly over the cell probabilities, within the standard
     error over the draws)."""
     sky, theta_e, phi_e, L = uneven_map(tmp_path, "cosine")
-    sc, _ = scene.build(load_config(base(sky)))
+    sc = scene.build(load_config(base(sky)))
     solid_cos = cell_mass(theta_e, phi_e, np.ones_like(L))
     energy = np.sum(L * np.diff(np.sin(np.radians(theta_e)) ** 2)[:, None]
                     * np.radians(np.diff(phi_e))[None, :] / 2.0)
     expected_weight = L * math.pi / energy
-    np.testing.assert_allclose(sc.sky_cell_L, expected_weight, rtol=1e-12)
+    rec = sc.sky[0]
+    cell_l = sc.sf[rec["cell_l"]:rec["cell_l"] + L.size].reshape(L.shape)
+    np.testing.assert_allclose(cell_l, expected_weight, rtol=1e-12)
     assert np.sum(solid_cos * expected_weight) == pytest.approx(1.0, rel=1e-12)
     n = 300_000
-    u = sky_many(sc, n, 2)
+    u = sky_many(sc.sky, sc.sf, n, 2)
     assert np.all(u[:, 2] > 0.0)
     np.testing.assert_allclose(np.linalg.norm(u[:, :3], axis=1), 1.0, atol=1e-12)
     t, p = view_angles(u)
@@ -539,11 +543,10 @@ def test_exr_map_reading(tmp_path):
 
 
 def assert_same_fields(a, b):
-    assert sorted(a) == sorted(b)
-    for key in a:
-        x, y = np.asarray(a[key]), np.asarray(b[key])
-        assert x.dtype == y.dtype and x.shape == y.shape, key
-        assert np.array_equal(x, y), key
+    """Two packed skies, (record, pool), are the same bit for bit."""
+    (rec_a, pool_a), (rec_b, pool_b) = a, b
+    assert rec_a.tobytes() == rec_b.tobytes()
+    assert pool_a.dtype == pool_b.dtype and np.array_equal(pool_a, pool_b)
 
 
 @pytest.mark.parametrize("sampling", ["importance", "cosine"])
@@ -558,19 +561,18 @@ def test_exr_map_same_tables_as_npy(tmp_path, sampling):
     write_exr(tmp_path / "sphere.exr", {"Y": Y})
     np.save(tmp_path / "sphere.npy", Y[:5].astype(np.float64))
     for name in ("rgb", "sphere"):
-        fields = [sky_maps.sky_fields(load_config(base(
+        packed = [sky_packer.pack(load_config(base(
             {"map": str(tmp_path / f"{name}.{ext}"), "sampling": sampling})).illumination)
             for ext in ("exr", "npy")]
-        assert_same_fields(*fields)
-        assert fields[0]["sky_cell_L"].shape == ((9, 24) if name == "rgb" else (5, 20))
+        assert_same_fields(*packed)
+        rec = packed[0][0][0]
+        assert (rec["n_rows"], rec["n_cols"]) == ((9, 24) if name == "rgb" else (5, 20))
     # and through the whole scene
-    a, _ = scene.build(load_config(base({"map": str(tmp_path / "rgb.exr"),
-                                         "sampling": sampling})))
-    b, _ = scene.build(load_config(base({"map": str(tmp_path / "rgb.npy"),
-                                         "sampling": sampling})))
-    for key in ("sky_model", "sky_s_edges", "sky_phi_edges", "sky_row_cdf", "sky_cell_cdf",
-                "sky_cell_L", "sky_params"):
-        assert np.array_equal(np.asarray(getattr(a, key)), np.asarray(getattr(b, key))), key
+    a = scene.build(load_config(base({"map": str(tmp_path / "rgb.exr"),
+                                      "sampling": sampling})))
+    b = scene.build(load_config(base({"map": str(tmp_path / "rgb.npy"),
+                                      "sampling": sampling})))
+    assert_same_fields((a.sky, a.sf), (b.sky, b.sf))
 
 
 def test_bad_exr_files(tmp_path):

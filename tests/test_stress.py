@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import oceanmc
-from oceanmc.kernel.interface import fresnel
+from oceanmc.kernel.surface.fresnel import fresnel
 
 
 def run(scene, photons=20_000, batches=8, seed=3):

@@ -13,8 +13,6 @@ from scipy import integrate
 import oceanmc
 from oceanmc import scene
 from oceanmc.kernel import upward
-from oceanmc.kernel.driver import features_of
-from oceanmc.kernel.models import FEATURE_UPWARD
 
 from stats_helpers import assert_same, assert_z, dof_of
 
@@ -33,16 +31,17 @@ def arrays(a=0.1, b=0.4, fraction=FRACTION):
                               "phase": {"model": "henyey_greenstein", "g": G}}]},
         "bottom": {"model": "black"},
         "estimator": {"upward_fraction": fraction, "upward_cone_deg": CONE_DEG}})
-    return scene.build(config)[0]
+    return scene.build(config)
 
 
 @njit(cache=False)
 def _draw(sc, n, seed, ux, uy, uz):
+    medium, mf, mi = sc
     np.random.seed(seed)
     weights = np.empty(n)
     up = np.empty(n)
     for i in range(n):
-        w, nx, ny, nz = upward.scatter(sc, 0, 1.0, ux, uy, uz)
+        w, nx, ny, nz = upward.scatter(medium[0], mf, mi, 0, 1.0, ux, uy, uz)
         weights[i] = w
         up[i] = -nz
     return weights, up
@@ -74,7 +73,8 @@ def test_biased_sampler_keeps_every_ring(theta_in_deg):
     sc = arrays()
     theta = math.radians(theta_in_deg)
     # up is -z: a direction at theta from straight up has uz = -cos(theta)
-    weights, up = _draw(sc, N_DRAWS, 7, math.sin(theta), 0.0, -math.cos(theta))
+    weights, up = _draw((sc.medium, sc.mf, sc.mi), N_DRAWS, 7, math.sin(theta), 0.0,
+                        -math.cos(theta))
     assert weights.max() <= 1.0 / (1.0 - FRACTION) * (1.0 + 1e-12)
     assert np.all(weights > 0.0)
     ring = np.digitize(up, RING_EDGES[1:-1])
@@ -96,10 +96,12 @@ def test_biased_sampler_keeps_every_ring(theta_in_deg):
 def test_fraction_is_capped_by_the_albedo():
     """min(upward_fraction, 1 - w0) per layer, so a scattering event never makes a packet
     heavier; the feature bit is set only with a positive fraction."""
-    assert arrays(a=0.1, b=0.4).layer_up_fraction[0] == pytest.approx(0.1)
-    assert arrays(a=0.01, b=0.99).layer_up_fraction[0] == pytest.approx(0.01)
-    assert features_of(arrays()) & FEATURE_UPWARD
-    assert not features_of(arrays(fraction=None)) & FEATURE_UPWARD
+    def fraction(sc):
+        return sc.mf[sc.medium[0]["up_fraction"]]
+    assert fraction(arrays(a=0.1, b=0.4)) == pytest.approx(0.1)
+    assert fraction(arrays(a=0.01, b=0.99)) == pytest.approx(0.01)
+    assert arrays().estimator[0]["upward"]
+    assert not arrays(fraction=None).estimator[0]["upward"]
 
 
 def test_rejected_with_the_analog_walk():

@@ -2,7 +2,8 @@
 import math
 
 import numpy as np
-from numba import njit
+
+from .compile import kernel
 
 AZIMUTH_NODES = 1024
 AZIMUTH_STEP = 2.0 * math.pi / AZIMUTH_NODES
@@ -11,7 +12,7 @@ NODE_COS = np.cos(np.arange(AZIMUTH_NODES) * AZIMUTH_STEP)
 NODE_SIN = np.sin(np.arange(AZIMUTH_NODES) * AZIMUTH_STEP)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def cos_sin_turn(u):
     """(cos, sin) of the azimuth 2 pi u, u in [0, 1): the node below it from a table and the
     angle addition formulas with the Taylor series of the remainder d < 2 pi / 1024, to d^6 in
@@ -28,7 +29,7 @@ def cos_sin_turn(u):
             NODE_SIN[k] * cos_d + NODE_COS[k] * sin_d)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def renormalised(nx, ny, nz):
     """(nx, ny, nz) / |n| for a vector whose length is 1 up to rounding: one Newton step for
     1/sqrt(s) from 1, 1/sqrt(s) ~ (3 - s)/2, leaves a relative error of order (s - 1)^2, so the
@@ -38,7 +39,7 @@ def renormalised(nx, ny, nz):
     return nx * norm, ny * norm, nz * norm
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def turn(ux, uy, uz, cos_t, u_phi):
     """The direction at polar angle acos(cos_t) and azimuth 2 pi u_phi about (ux, uy, uz),
     renormalised (the MCML rotation; Wang, Jacques & Zheng 1995, Comput. Meth. Prog. Bio. 47, 131); unit
@@ -60,7 +61,7 @@ def turn(ux, uy, uz, cos_t, u_phi):
     return renormalised(nx, ny, nz)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def from_angles(cos_t, phi):
     """Unit vector with polar cosine cos_t about +z and azimuth phi from +x."""
     sin_t = math.sqrt(max(0.0, 1.0 - cos_t * cos_t))

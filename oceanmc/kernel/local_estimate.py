@@ -17,9 +17,9 @@ A mirror bottom has no density to evaluate, so scenes with one do not use these 
 import math
 
 import numpy as np
-from .compile import internal
 
 from .brdf import dispatch as brdf
+from .compile import internal
 from .geometry import from_angles
 from .phase import dispatch as phase
 from .surface import dispatch as surface_bsdf

@@ -7,11 +7,12 @@ import numpy as np
 from numba import njit
 
 from .brdf.general import first_above
+from .compile import kernel
 from .geometry import from_angles
 from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP, SKY_MAP_COSINE
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sky_cosine(sky_model):
     """Cosine of the travel direction's angle from nadir for a sky photon: density proportional to
     L(theta) cos(theta). Uniform L: cos = sqrt(u). Cardioidal L ~ 1 + 2 cos: the cosine-weighted
@@ -24,7 +25,7 @@ def sky_cosine(sky_model):
     return math.sqrt(np.random.random())
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def harrison_coombes(sf, p, ux, uy, uz):
     """Harrison & Coombes (1988) radiance of the sky element a photon travelling (ux, uy, uz)
     comes from (sf[p:p + 4]: sun travel direction, cos of the sun zenith); sky_maps.py has the
@@ -36,7 +37,7 @@ def harrison_coombes(sf, p, ux, uy, uz):
             * horizon * (1.0 - math.exp(-0.53 / sf[p + 3])))
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sky_direction(sky, sf):
     """(ux, uy, uz, weight factor) of a sky photon's travel direction. Tabulated skies: a row by
     the marginal CDF, a cell by the row's conditional CDF, sin^2(theta) and phi uniform within

@@ -11,14 +11,11 @@ tally depths first, then grid.air_level (0+, all light) and grid.air_level + 1 (
 light only)."""
 import math
 
-from numba import njit
-
-from .compile import internal
-
+from .compile import internal, kernel
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def theta_band(uz, mu_edges):
     """Index i with mu_edges[i] >= uz > mu_edges[i + 1] (mu_edges falls from 1 to -1)."""
     lo = 0
@@ -32,7 +29,7 @@ def theta_band(uz, mu_edges):
     return lo
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def theta_band_fast(grid, gf, gi, uz):
     """theta_band by table: theta_lookup[k] is the band of the top of the k-th of M equal cells
     of uz in [-1, 1]; lower values in the same cell can only be in that band or a later one, so
@@ -46,7 +43,7 @@ def theta_band_fast(grid, gf, gi, uz):
     return band
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def phi_band(ux, uy, n_phi):
     """Band index with band 0 centred on phi = 0 (the sun's travel azimuth)."""
     phi = math.atan2(uy, ux)
@@ -54,7 +51,7 @@ def phi_band(ux, uy, n_phi):
     return k % n_phi
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def phi_band_fast(grid, gf, ux, uy):
     """phi_band without atan2: a polynomial guess of the azimuth (error < 0.0038 rad; Rajan et
     al. 2006, IEEE Signal Process. Mag. 23(3)). The bands are equal, so a guess farther than
@@ -93,7 +90,7 @@ def phi_band_fast(grid, gf, ux, uy):
         k = up
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def inverse_mu(uz, mu_cut, beam):
     """1/|mu|, or 2/mu_cut below the cut for diffuse light. A collimated beam (the unscattered
     sun) always gets the exact 1/|mu|: every packet of it has the same mu, so there is no

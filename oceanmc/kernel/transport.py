@@ -1,12 +1,15 @@
 """The photon loop: weighted photon packets from the sun and sky, through the surface, the layered
 water and off the bottom, until they leave, are absorbed or lose Russian roulette.
 
-The walk is a sequence of events, each an ordinary compiled function with one call site:
-free_flight (to the next collision or plane), collide, cross_plane, and behind a plane the
-surface from below (leave_or_reflect) or the bottom (reflect_at_bottom); a packet from the air
-meets the surface in enter_from_air. Only trace_batch sees the whole scene; each event takes
-the component records and pools it needs (kernel/records.py) and the packet, a PACKET record
-that it updates in place.
+The walk is a sequence of events, each an ordinary compiled function with one call site in
+trace_batch's event loop (move to the next event, then handle it, as MC/DC's loop does):
+free_flight (to the next collision or plane), collide, cross_plane, and on the surface
+leave_or_reflect, on the bottom reflect_at_bottom, after either after_reflection; a packet from
+the air meets the surface in enter_from_air. Only trace_batch sees the whole scene; each event
+takes the component records and pools it needs (kernel/records.py) and the packet, a PACKET
+record that it updates in place. The event functions carry LLVM's alwaysinline attribute
+(kernel/compile.py): compiled once each, they are merged into the loop by LLVM, not copied by
+Numba.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -27,10 +30,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .compile import internal
-
 from . import local_estimate, upward
 from .brdf import dispatch as brdf
+from .compile import internal
 from .geometry import turn
 from .models import (BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, BUDGET_SURFACE_REFLECTION,
                      BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
@@ -43,6 +45,10 @@ from .tally import score_crossing
 FLIGHT_COLLISION = 0
 FLIGHT_PLANE = 1
 FLIGHT_GONE = 2     # absorbed in, or lost below, a layer that does not scatter
+# what a plane is
+PLANE_INSIDE = 0
+PLANE_SURFACE = 1
+PLANE_BOTTOM = 2
 
 
 @internal
@@ -275,25 +281,25 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
 
 
 @internal
-def cross_plane(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi, est, ef, ei, tally,
-                stack, n_stacked, p, target):
-    """The packet is on plane `target`: scored if the plane is a tally level; at the surface or
-    the bottom it leaves, is absorbed or is reflected (and then crosses the level again, may be
-    split, and plays roulette); elsewhere it enters the next segment. Returns (alive, stack
-    height)."""
+def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
+    """The packet is on plane `target`: scored if the plane is a tally level; returns what the
+    plane is (PLANE_SURFACE, PLANE_BOTTOM, or PLANE_INSIDE, where the packet has gone on into
+    the next segment) and the plane's tally level (-1: none)."""
     level = mi[medium.plane_tally + target]
     if level >= 0:
         score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
     if target == 0:
-        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p)
-    elif target == medium.n_planes - 1:
-        alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei,
-                                  tally, p)
-    else:
-        p.seg = target if p.uz > 0.0 else target - 1
-        return True, n_stacked
-    if not alive:
-        return False, n_stacked
+        return PLANE_SURFACE, level
+    if target == medium.n_planes - 1:
+        return PLANE_BOTTOM, level
+    p.seg = target if p.uz > 0.0 else target - 1
+    return PLANE_INSIDE, level
+
+
+@internal
+def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level):
+    """A packet reflected at the surface or the bottom crosses its plane's tally level again,
+    may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
         score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
@@ -301,30 +307,7 @@ def cross_plane(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi, est, ef
     return survives_roulette(ctrl, p), n_stacked
 
 
-@internal
-def walk(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi, est, ef, ei, tally, stack,
-         n_stacked, p):
-    """Follows packet p in the water (just below the surface, or a split copy) until it leaves,
-    is absorbed or loses roulette; returns its scattering count and the stack height."""
-    tau = exponential()
-    events = 0
-    while p.w > 0.0:
-        outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau)
-        if outcome == FLIGHT_COLLISION:
-            events += 1
-            alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, where,
-                                 events)
-        elif outcome == FLIGHT_PLANE:
-            alive, n_stacked = cross_plane(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf,
-                                           gi, est, ef, ei, tally, stack, n_stacked, p, where)
-        else:
-            alive = False
-        if not alive:
-            break
-    return events, n_stacked
-
-
-@njit(error_model="numpy", cache=True, nogil=True)
+@njit(error_model="numpy", cache=True, nogil=True, _nrt=False)
 def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
                 est_row, ef, ei, ctrl_row, n_photons, seed, tally, packet_row, stack):
     """One batch: its own random stream (seeded from (seed, batch) by the caller; Numba's
@@ -370,9 +353,28 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, stack, n_stacked, p)
         while True:
-            traced, n_stacked = walk(medium, mf, mi, surface, bottom, bp, ctrl, grid, gf, gi,
-                                     est, ef, ei, tally, stack, n_stacked, p)
-            events += traced
+            # the walk of packet p as a sequence of events, until it leaves, is absorbed or
+            # loses roulette; then the next of its split copies, if any
+            tau = exponential()
+            alive = True
+            while alive and p.w > 0.0:
+                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau)
+                if outcome == FLIGHT_COLLISION:
+                    events += 1
+                    alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p,
+                                         where, events)
+                elif outcome == FLIGHT_PLANE:
+                    plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
+                    if plane == PLANE_SURFACE:
+                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p)
+                    elif plane == PLANE_BOTTOM:
+                        alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf,
+                                                  est, ef, ei, tally, p)
+                    if alive and plane != PLANE_INSIDE:
+                        alive, n_stacked = after_reflection(ctrl, grid, gf, gi, tally, stack,
+                                                            n_stacked, p, level)
+                else:
+                    alive = False
             if n_stacked == 0:
                 break
             n_stacked -= 1

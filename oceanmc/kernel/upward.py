@@ -20,13 +20,13 @@ f <= 1 - w0 (scene/medium.py), so no scattering event makes a packet heavier: wi
 import math
 
 import numpy as np
-from numba import njit
 
+from .compile import kernel
 from .geometry import cos_sin_turn, turn
 from .phase import dispatch as phase
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def scatter(medium, mf, mi, layer, w, ux, uy, uz):
     """(w, ux, uy, uz) after a scattering event in `layer` of a packet of weight w (already
     times the albedo) travelling (ux, uy, uz); up is -z."""

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import config as cfg
+from .. import registry
 from ..config import ConfigError
 from ..kernel import models
 from ..kernel.brdf import tables as ktables
@@ -204,12 +205,6 @@ def pack_table(table: dict, reflectance_factor: bool) -> np.ndarray:
 
 # --- the packed parameter array ---------------------------------------------------------------
 
-MODEL_IDS = {"none": models.BOTTOM_NONE, "black": models.BOTTOM_BLACK,
-             "lambertian": models.BOTTOM_LAMBERTIAN, "minnaert": models.BOTTOM_MINNAERT,
-             "specular": models.BOTTOM_SPECULAR,
-             "lambertian_specular": models.BOTTOM_LAMBERTIAN_SPECULAR,
-             "ggx": models.BOTTOM_GGX, "hapke": models.BOTTOM_HAPKE,
-             "table": models.BOTTOM_TABLE}
 
 
 def scalars(bottom) -> list[float]:
@@ -356,7 +351,7 @@ def bottom_arrays(bottom, diagnostics: dict | None = None) -> tuple[int, np.ndar
     builds the general sampler's tables where needed and runs the physical checks. Raises
     TableError / ConfigError naming the model (and file) and the worst incidence angle.
     diagnostics, if given, receives the incident nodes and the cell integrals."""
-    model = MODEL_IDS[bottom.model]
+    model = registry.bottom_id(bottom.model)
     params = np.zeros(models.BRDF_HEADER)
     sc = scalars(bottom)
     params[:len(sc)] = sc

@@ -28,34 +28,36 @@ class Column:
     albedo: np.ndarray         # per layer
 
 
+def _mixture(phase: cfg.Mixture) -> list:
+    total = sum(c.b for c in phase.components)
+    out = []
+    for comp in phase.components:
+        share = comp.b / total if total > 0.0 else 1.0 / len(phase.components)
+        out += [(share * w, m, p, t) for w, m, p, t in phase_components(comp.phase)]
+    return out
+
+
+# schema phase model -> its kernel components (registry.PHASE lists the kernel models of each)
+COMPONENTS = {
+    "isotropic": lambda phase: [(1.0, models.PHASE_ISOTROPIC, [], None)],
+    "rayleigh": lambda phase: [(1.0, models.PHASE_QUADRATIC, [RAYLEIGH_BETA], None)],
+    "pure_water": lambda phase: [(1.0, models.PHASE_QUADRATIC, [PURE_WATER_BETA], None)],
+    "henyey_greenstein": lambda phase: [(1.0, models.PHASE_HG, [phase.g], None)],
+    "two_term_hg": lambda phase: [(phase.alpha, models.PHASE_HG, [phase.g1], None),
+                                  (1.0 - phase.alpha, models.PHASE_HG, [phase.g2], None)],
+    "fournier_forand": lambda phase: [(1.0, models.PHASE_TABULATED, [],
+                                       phase_tables.fournier_forand_table(phase.bb_ratio))],
+    "petzold": lambda phase: [(1.0, models.PHASE_TABULATED, [], phase_tables.petzold_table())],
+    "table": lambda phase: [(1.0, models.PHASE_TABULATED, [],
+                             phase_tables.user_table(phase.file))],
+    "mixture": _mixture,
+}
+
+
 def phase_components(phase) -> list[tuple[float, int, list[float], tuple | None]]:
-    """(relative weight, model id, params, table) for each component of a layer's phase."""
-    if isinstance(phase, cfg.Mixture):
-        total = sum(c.b for c in phase.components)
-        out = []
-        for comp in phase.components:
-            share = comp.b / total if total > 0.0 else 1.0 / len(phase.components)
-            out += [(share * w, m, p, t) for w, m, p, t in phase_components(comp.phase)]
-        return out
-    if isinstance(phase, cfg.Isotropic):
-        return [(1.0, models.PHASE_ISOTROPIC, [], None)]
-    if isinstance(phase, cfg.Rayleigh):
-        return [(1.0, models.PHASE_QUADRATIC, [RAYLEIGH_BETA], None)]
-    if isinstance(phase, cfg.PureWater):
-        return [(1.0, models.PHASE_QUADRATIC, [PURE_WATER_BETA], None)]
-    if isinstance(phase, cfg.HenyeyGreenstein):
-        return [(1.0, models.PHASE_HG, [phase.g], None)]
-    if isinstance(phase, cfg.TwoTermHG):
-        return [(phase.alpha, models.PHASE_HG, [phase.g1], None),
-                (1.0 - phase.alpha, models.PHASE_HG, [phase.g2], None)]
-    if isinstance(phase, cfg.FournierForand):
-        return [(1.0, models.PHASE_TABULATED, [],
-                 phase_tables.fournier_forand_table(phase.bb_ratio))]
-    if isinstance(phase, cfg.Petzold):
-        return [(1.0, models.PHASE_TABULATED, [], phase_tables.petzold_table())]
-    if isinstance(phase, cfg.TablePhase):
-        return [(1.0, models.PHASE_TABULATED, [], phase_tables.user_table(phase.file))]
-    raise AssertionError(f"unhandled phase model {phase!r}")
+    """(relative weight, kernel model id, params, table) for each component of a layer's
+    phase function."""
+    return COMPONENTS[phase.model](phase)
 
 
 def planes(config: cfg.SceneConfig):

@@ -7,12 +7,10 @@ import math
 import numpy as np
 
 from .. import config as cfg
+from .. import registry
 from ..kernel import models
 from ..kernel.records import SKY, Pool, record
 from . import sky_maps
-
-SKY_MODELS = {"uniform": models.SKY_UNIFORM, "cardioidal": models.SKY_CARDIOIDAL,
-              "overcast": models.SKY_CARDIOIDAL, "harrison_coombes": models.SKY_HARRISON_COOMBES}
 
 
 def pack(ill: cfg.Illumination) -> tuple[np.ndarray, np.ndarray]:
@@ -21,17 +19,17 @@ def pack(ill: cfg.Illumination) -> tuple[np.ndarray, np.ndarray]:
     sky = ill.sky
     theta_s = math.radians(ill.sun_zenith_deg)
     if isinstance(sky, str) and sky != "harrison_coombes":
-        model = SKY_MODELS[sky]
+        model = registry.SKY[sky]
         tables = {"s_edges": np.zeros(2), "phi_edges": np.zeros(2), "row_cdf": np.ones(1),
                   "cell_cdf": np.ones((1, 1)), "cell_l": np.ones((1, 1))}
         params = np.zeros(8)
     else:
         if isinstance(sky, str):
             theta, phi, L = sky_maps.harrison_coombes_cells(ill.sun_zenith_deg)
-            model = models.SKY_HARRISON_COOMBES
+            model = registry.SKY[sky]
         else:
             theta, phi, L = sky_maps.read_sky_map(sky.map, sky.dataset, sky.layout)
-            model = models.SKY_MAP if sky.sampling == "importance" else models.SKY_MAP_COSINE
+            model = registry.SKY_MAP[sky.sampling]
         tables = sky_maps.sampling_tables(theta, phi, L)
         if model == models.SKY_MAP_COSINE:
             # the cosine sampler uses only the edges; the cells hold its photon weights

@@ -5,19 +5,18 @@ A model whose parameter array asks for it (params[BRDF_SAMPLER] = 1: Hapke, meas
 any model with `sampling: tabulated`) is sampled by the general tabulated sampler (general.py)
 and weighted f cos / pdf with its own evaluate(); the others use their own exact samplers. The
 length check on params keeps short parameter arrays (tests) on the models' own samplers."""
-from numba import njit
-
+from ..compile import kernel
 from ..models import (BOTTOM_GGX, BOTTOM_HAPKE, BOTTOM_LAMBERTIAN, BOTTOM_LAMBERTIAN_SPECULAR,
                       BOTTOM_MINNAERT, BOTTOM_SPECULAR, BOTTOM_TABLE, BRDF_SAMPLER)
 from . import general, ggx, hapke, lambertian, lambertian_specular, minnaert, specular, table
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def tabulated_sampler(params):
     return params.shape[0] > BRDF_SAMPLER and params[BRDF_SAMPLER] > 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
     """f(wi, wo) in 1/sr; for models with a mirror component only the finite part (local
     estimates miss the mirror: config.py refuses them for such bottoms)."""
@@ -38,7 +37,7 @@ def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample_local(model, params, wix, wiy, wiz, u1, u2):
     """(wox, woy, woz, weight) with weight = f cos(theta_o) / pdf."""
     if tabulated_sampler(params):
@@ -59,7 +58,7 @@ def sample_local(model, params, wix, wiy, wiz, u1, u2):
     return 0.0, 0.0, 1.0, 0.0  # black (Hapke and tables always use the tabulated sampler)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
     """Density (1/sr) of the sampler in use; for a mirror component only its finite part."""
     if tabulated_sampler(params):
@@ -77,7 +76,7 @@ def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def reflect(model, params, ux, uy, uz, u1, u2):
     """A photon travelling (ux, uy, uz), uz > 0, meets the bottom: returns the reflected travel
     direction (upward) and the weight factor. Local frame = (x, -y, -z) of the global one (a

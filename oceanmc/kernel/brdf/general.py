@@ -24,15 +24,14 @@ the tabulation only decides how constant the weights are (for a Lambertian BRDF 
 rho), never their expectation, which is rho_dh(wi) (brdf_tables.py documents the accuracy)."""
 import math
 
-from numba import njit
-
+from ..compile import kernel
 from ..models import BRDF_SAMPLER_AT
 
 HEADER = 8
 TWO_PI = 2.0 * math.pi
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def layout(params):
     o = int(params[BRDF_SAMPLER_AT])
     n_ti = int(params[o])
@@ -45,7 +44,7 @@ def layout(params):
     return n_ti, n_pi, n_t, n_p, s_at, blocks, block
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def incident_nodes(n_ti, n_pi, wix, wiy, wiz):
     """(a, t, b, tb, phi_i): nodes a, a + 1 in theta_i with weights 1 - t, t; nodes b, b + 1
     (mod n_pi) in phi_i with weights 1 - tb, tb; the azimuth of wi."""
@@ -63,7 +62,7 @@ def incident_nodes(n_ti, n_pi, wix, wiy, wiz):
     return a, t, b, tb, phi_i
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def first_above(params, start, n, u):
     """Smallest k in 0 .. n - 1 with u < params[start + k] (the last entry is 1)."""
     lo = -1
@@ -77,12 +76,12 @@ def first_above(params, start, n, u):
     return hi
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def node_density(params, blocks, block, n_t, n_p, node, c, r):
     return params[blocks + node * block + n_p + n_p * n_t + c * n_t + r]
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def density(params, wix, wiy, wiz, wox, woy, woz):
     """pdf(wo) / cos(theta_o) of the sampler for incidence wi (1/sr)."""
     n_ti, n_pi, n_t, n_p, s_at, blocks, block = layout(params)
@@ -106,14 +105,14 @@ def density(params, wix, wiy, wiz, wox, woy, woz):
     return total
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     if woz <= 0.0:
         return 0.0
     return density(params, wix, wiy, wiz, wox, woy, woz) * woz
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def rescale(u, lo, hi):
     """Where u lies in [lo, hi), as a fraction in [0, 1)."""
     width = hi - lo
@@ -122,7 +121,7 @@ def rescale(u, lo, hi):
     return min(max((u - lo) / width, 0.0), 1.0 - 1e-16)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, wix, wiy, wiz, u1, u2):
     """(wox, woy, woz, pdf / cos(theta_o)) for incidence wi."""
     n_ti, n_pi, n_t, n_p, s_at, blocks, block = layout(params)

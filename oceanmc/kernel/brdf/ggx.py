@@ -26,13 +26,12 @@ pure microfacet reflection is F G2 / G1(wi) <= 1. A reflected direction below th
 f = 0: it comes back as (0, 0, 1) with weight 0."""
 import math
 
-from numba import njit
-
+from ..compile import kernel
 from ..geometry import from_angles
 from ..surface.fresnel import fresnel as fresnel_r
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def lam(alpha, vz):
     """Smith's Lambda for GGX at direction cosine vz > 0."""
     c2 = vz * vz
@@ -42,21 +41,21 @@ def lam(alpha, vz):
     return 0.5 * (math.sqrt(1.0 + alpha * alpha * t2) - 1.0)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def distribution(alpha, hz):
     a2 = alpha * alpha
     d = hz * hz * (a2 - 1.0) + 1.0
     return a2 / (math.pi * d * d)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def facet_reflectance(params, cos_h):
     if params[3] == 0.0:
         return 1.0
     return fresnel_r(1.0, params[1], min(1.0, max(0.0, cos_h)))[0]
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def half_vector(wix, wiy, wiz, wox, woy, woz):
     """The unit bisector of wi and wo; (0, 0, 0) when they are opposite."""
     hx = wix + wox
@@ -68,7 +67,7 @@ def half_vector(wix, wiy, wiz, wox, woy, woz):
     return hx / norm, hy / norm, hz / norm
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def specular(params, wix, wiy, wiz, wox, woy, woz):
     """The microfacet part of f (1/sr)."""
     if wiz <= 0.0 or woz <= 0.0:
@@ -82,14 +81,14 @@ def specular(params, wix, wiy, wiz, wox, woy, woz):
     return facet_reflectance(params, cos_h) * distribution(alpha, hz) * g2 / (4.0 * wiz * woz)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
     return specular(params, wix, wiy, wiz, wox, woy, woz) + params[2] / math.pi
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def specular_share(params, wiz):
     if params[2] <= 0.0:
         return 1.0
@@ -97,7 +96,7 @@ def specular_share(params, wiz):
     return max(0.2, fs / (fs + params[2]))
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def specular_pdf(params, wix, wiy, wiz, wox, woy, woz):
     """Density of the reflected visible-normal sample: G1(wi) D(h) / (4 cos t_i)."""
     if wiz <= 0.0 or woz <= 0.0:
@@ -110,7 +109,7 @@ def specular_pdf(params, wix, wiy, wiz, wox, woy, woz):
     return g1 * distribution(alpha, hz) / (4.0 * wiz)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
@@ -118,7 +117,7 @@ def pdf(params, wix, wiy, wiz, wox, woy, woz):
     return q * specular_pdf(params, wix, wiy, wiz, wox, woy, woz) + (1.0 - q) * woz / math.pi
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def visible_normal(alpha, wix, wiy, wiz, u1, u2):
     """A microfacet normal drawn from GGX's distribution of visible normals seen from wi (Heitz
     2018, listing 1)."""
@@ -158,7 +157,7 @@ def visible_normal(alpha, wix, wiy, wiz, u1, u2):
     return hx * hn, hy * hn, hz * hn
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, wix, wiy, wiz, u1, u2):
     if wiz <= 0.0:
         return 0.0, 0.0, 1.0, 0.0

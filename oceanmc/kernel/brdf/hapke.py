@@ -21,10 +21,10 @@ rho_dh can exceed 1 for bright grains and a strong surge: the scene check report
 tabulated sampler (general.py) samples it."""
 import math
 
-from numba import njit
+from ..compile import kernel
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def chandrasekhar_h(w, r0, x):
     """Hapke's (2002) approximation to Chandrasekhar's H function for isotropic scatterers."""
     if x <= 0.0:
@@ -32,7 +32,7 @@ def chandrasekhar_h(w, r0, x):
     return 1.0 / (1.0 - w * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * math.log((1.0 + x) / x)))
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0

@@ -10,13 +10,12 @@ finite pair of directions. Local (next-event) estimates therefore miss the mirro
 why config.py refuses local estimates with a bottom that has a mirror component."""
 import math
 
-from numba import njit
-
+from ..compile import kernel
 from ..geometry import from_angles
 from . import lambertian
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, wix, wiy, wiz, u1, u2):
     rho_d = params[0]
     rho_s = params[1]
@@ -31,14 +30,14 @@ def sample(params, wix, wiy, wiz, u1, u2):
     return wox, woy, woz, total
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     """The diffuse part only (the mirror is a delta function; see the module note): the
     Lambertian f of reflectance params[0]."""
     return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     """Density of the diffuse branch (probability 1 - p_s times cos/pi); the mirror branch is
     a point mass of probability p_s, not a density."""

@@ -1,18 +1,18 @@
 """A mirror of reflectance rho = params[0]: wo is wi mirrored about the normal, weight rho.
 The BRDF is a delta function, so evaluate and pdf (densities) are 0 for every finite pair."""
-from numba import njit
+from ..compile import kernel
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, wix, wiy, wiz, u1, u2):
     return -wix, -wiy, wiz, params[0]
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     return 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf(params, wix, wiy, wiz, wox, woy, woz):
     return 0.0

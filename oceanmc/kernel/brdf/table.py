@@ -15,14 +15,13 @@ f is multilinear in (theta_i, phi_i, theta_r, dphi) between the nodes and consta
 first and last theta nodes (tables rarely reach grazing angles)."""
 import math
 
-from numba import njit
-
+from ..compile import kernel
 from ..models import BRDF_TABLE_AT
 
 HEADER = 8
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def locate(params, start, n, x):
     """(index of the node at or below x, fraction towards the next) on nodes params[start:start+n],
     clamped to the node range; a single node gives (0, 0)."""
@@ -44,7 +43,7 @@ def locate(params, start, n, x):
     return lo, (x - x0) / (params[start + lo + 1] - x0)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0

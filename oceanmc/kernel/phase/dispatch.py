@@ -6,18 +6,19 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compile import kernel
 from ..models import PHASE_HG, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def component_params(medium, mf, k):
     """Component k's two parameters as a tuple of floats."""
     at = medium.comp_params + 2 * k
     return (mf[at], mf[at + 1])
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def table_at(medium, mi, k):
     """(psi, q, cdf offsets, node count) of component k's table in the float pool."""
     start = mi[medium.comp_tab_start + k]
@@ -25,7 +26,7 @@ def table_at(medium, mi, k):
             mi[medium.comp_tab_len + k])
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample_component(medium, mf, mi, k, u):
     model = mi[medium.comp_model + k]
     if model == PHASE_HG:
@@ -38,7 +39,7 @@ def sample_component(medium, mf, mi, k, u):
     return isotropic.sample(component_params(medium, mf, k), u)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate_component(medium, mf, mi, k, cos_psi):
     model = mi[medium.comp_model + k]
     if model == PHASE_HG:
@@ -51,7 +52,7 @@ def evaluate_component(medium, mf, mi, k, cos_psi):
     return isotropic.evaluate(component_params(medium, mf, k), cos_psi)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample_cos(medium, mf, mi, layer, u_pick, u):
     """cos(psi) from the layer's phase function; u_pick chooses the component of a mixture with
     probability b_k / b (it is ignored for a single component, so the caller need not draw it),
@@ -63,7 +64,7 @@ def sample_cos(medium, mf, mi, layer, u_pick, u):
     return sample_component(medium, mf, mi, k, u)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(medium, mf, mi, layer, cos_psi):
     """The layer's phase function p(cos_psi) in 1/sr: the b-weighted sum of its components."""
     first = mi[medium.comp_start + layer]

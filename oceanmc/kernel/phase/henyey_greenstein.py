@@ -3,10 +3,10 @@ cos = (1 + g^2 - ((1 - g^2)/(1 - g + 2 g u))^2) / (2 g) (Henyey & Greenstein 194
 1995)."""
 import math
 
-from numba import njit
+from ..compile import kernel
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, u):
     g = params[0]
     if abs(g) < 1e-6:
@@ -15,7 +15,7 @@ def sample(params, u):
     return min(1.0, max(-1.0, (1.0 + g * g - t * t) / (2.0 * g)))
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, cos_psi):
     g = params[0]
     return (1.0 - g * g) / (4.0 * math.pi * (1.0 + g * g - 2.0 * g * cos_psi) ** 1.5)

@@ -1,13 +1,13 @@
 import math
 
-from numba import njit
+from ..compile import kernel
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, u):
     return 2.0 * u - 1.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, cos_psi):
     return 1.0 / (4.0 * math.pi)

@@ -3,10 +3,10 @@ beta = 1: Rayleigh-like (3/16 pi)(1 + cos^2); beta = 0.835: pure sea water 0.062
 (Morel 1974; Mobley 1994, Light and Water, Eq. 3.30)."""
 import math
 
-from numba import njit
+from ..compile import kernel
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(params, u):
     """Exact inversion of the CDF F(m) = (m + beta m^3/3 + 1 + beta/3) / (2 + 2 beta/3): the cubic
     m^3 + p m + q = 0 with p = 3/beta > 0 has one real root, taken in its hyperbolic form, which
@@ -22,7 +22,7 @@ def sample(params, u):
     return min(1.0, max(-1.0, m))
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(params, cos_psi):
     beta = params[0]
     return (1.0 + beta * cos_psi * cos_psi) / (2.0 * math.pi * (2.0 + 2.0 * beta / 3.0))

@@ -4,12 +4,12 @@ table's psi, q and cdf start at psi_at, q_at and cdf_at and have `length` nodes.
 the CDF exactly: within a node interval the CDF is quadratic in psi."""
 import math
 
-from numba import njit
+from ..compile import kernel
 
 EDGE = 1e-12
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(pool, psi_at, q_at, cdf_at, length, u):
     lo = 0
     hi = length - 1
@@ -31,7 +31,7 @@ def sample(pool, psi_at, q_at, cdf_at, length, u):
     return math.cos(angle)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def density(pool, psi_at, q_at, length, angle):
     """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
     between nodes)."""
@@ -49,7 +49,7 @@ def density(pool, psi_at, q_at, length, angle):
     return q0 + frac * (pool[q_at + lo + 1] - q0)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(pool, psi_at, q_at, length, cos_psi):
     """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
     tends to a finite limit, taken by staying EDGE rad inside the range."""

@@ -6,13 +6,12 @@ carried by sample(), which returns the direction and the weight f cos / pdf: cho
 with probability R, each branch's weight is 1. The photon loop's implicit estimator uses split()
 instead, the expected-value form of the same BSDF: both branches with their shares R and 1 - R.
 Local estimates through the surface ask for transmittance()."""
-from numba import njit
-
+from ..compile import kernel
 from ..models import SURFACE_FLAT
 from . import flat, index_matched
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def split(surface, ux, uy, uz):
     """(R, rx, ry, rz, tx, ty, tz): the share R reflected into (rx, ry, rz) and 1 - R
     transmitted into (tx, ty, tz), for a photon travelling (ux, uy, uz) that meets the surface
@@ -22,7 +21,7 @@ def split(surface, ux, uy, uz):
     return index_matched.split(surface, ux, uy, uz)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def sample(surface, ux, uy, uz, u):
     """(ox, oy, oz, weight, transmitted): reflection when u < R, else transmission; the weight
     f cos / pdf is 1 for either branch."""
@@ -32,19 +31,19 @@ def sample(surface, ux, uy, uz, u):
     return tx, ty, tz, 1.0, True
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def evaluate(surface, ux, uy, uz, ox, oy, oz):
     """f for a finite pair of directions: 0 for a delta BSDF (Mitsuba's convention)."""
     return 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def pdf(surface, ux, uy, uz, ox, oy, oz):
     """sample()'s density per steradian at a finite pair of directions: 0 for a delta BSDF."""
     return 0.0
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def transmittance(surface, mu):
     """The share of light travelling up at direction cosine mu in the water that leaves it."""
     if surface.model == SURFACE_FLAT:

@@ -1,12 +1,11 @@
 """The flat air-water surface: exact unpolarized Fresnel reflectance (or Schlick's, for
 comparisons) and Snell refraction, from the air and from the water, total internal reflection
 included. A delta BSDF: all light leaves in two directions, the mirror and the refracted one."""
-from numba import njit
-
+from ..compile import kernel
 from .fresnel import fresnel, refract, schlick
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def reflectance(surface, n1, n2, cos_i):
     """(R, cos_t) from index n1 into n2 with the surface's choice of formula."""
     if surface.schlick:
@@ -14,7 +13,7 @@ def reflectance(surface, n1, n2, cos_i):
     return fresnel(n1, n2, cos_i)
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def split(surface, ux, uy, uz):
     """(R, reflected direction, transmitted direction) for a photon travelling (ux, uy, uz)
     that meets the surface: from the air when uz > 0, from the water when uz < 0. Under total
@@ -29,7 +28,7 @@ def split(surface, ux, uy, uz):
     return r, ux, uy, -uz, tx, ty, tz
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def transmittance(surface, mu):
     """The share of upwelling light at direction cosine mu (in water, from the vertical) that
     leaves the water: 1 - R."""

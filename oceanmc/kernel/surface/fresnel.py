@@ -1,12 +1,11 @@
 """Fresnel reflectance and Snell refraction at a plane interface (shared by the surface models)."""
 import math
 
-from numba import njit
-
+from ..compile import kernel
 from ..geometry import renormalised
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def fresnel(n1, n2, cos_i):
     """(R, cos_t) for light going from index n1 into n2 at incidence cosine cos_i >= 0.
     R = (Rs + Rp)/2 (Born & Wolf, Principles of Optics, 1.5.3); total internal reflection gives
@@ -26,7 +25,7 @@ def fresnel(n1, n2, cos_i):
     return 0.5 * (rs * rs + rp * rp), cos_t
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def schlick(n1, n2, cos_i):
     """Schlick's approximation R0 + (1 - R0)(1 - cos)^5 (Schlick 1994), with the cosine taken on
     the less dense side and total internal reflection kept: offered for comparisons only."""
@@ -38,7 +37,7 @@ def schlick(n1, n2, cos_i):
     return r0 + (1.0 - r0) * (1.0 - c) ** 5, cos_t
 
 
-@njit(error_model="numpy", cache=True)
+@kernel
 def refract(ux, uy, uz, ratio, cos_t):
     """Direction after crossing a horizontal interface: tangential components scale by
     ratio = n1/n2 (Snell), the vertical one keeps its sign with magnitude cos_t."""

@@ -1,5 +1,6 @@
-"""The photon loop compiled per scene features (kernel/driver.py): the features are read right
-from the scene, and leaving a feature's code out changes nothing else. Tallies that use no
+"""What a scene uses is read from its records at run time (one compiled loop for every scene):
+the packers set each component's switches right, and a switched-off feature changes nothing
+else. Tallies that use no
 random numbers (radiance quads, the cap estimate without a bottom) are switched on and off in
 scenes that are otherwise the same: every other tally must stay bit-identical, since the random
 streams are the same."""
@@ -8,9 +9,6 @@ import pytest
 
 import oceanmc
 from oceanmc import scene
-from oceanmc.kernel.driver import features_of
-from oceanmc.kernel.models import (FEATURE_BOTTOM, FEATURE_ESTIMATES, FEATURE_RADIANCE,
-                                   FEATURE_SKY, FEATURE_SPLITTING, FEATURE_UPWARD)
 
 BASE = {
     "photons": 20_000, "batches": 4, "seed": 5,
@@ -33,21 +31,28 @@ def config(**changes):
     return oceanmc.load_config(data)
 
 
+def switches(sc) -> set[str]:
+    """The features a packed scene switches on, read from its records."""
+    on = {"radiance": sc.grid[0]["radiance_on"], "sky": sc.sky[0]["diffuse_fraction"] > 0.0,
+          "bottom": sc.bottom[0]["reflects"], "cap": sc.estimates[0]["cap_on"],
+          "directions": sc.estimates[0]["directions_on"],
+          "splitting": sc.estimator[0]["splitting"], "upward": sc.estimator[0]["upward"]}
+    return {name for name, value in on.items() if value}
+
+
 @pytest.mark.parametrize("changes, expected", [
-    ({"tallies.radiance": False}, 0),
-    ({}, FEATURE_RADIANCE),
-    ({"illumination.diffuse_fraction": 0.3}, FEATURE_RADIANCE | FEATURE_SKY),
-    ({"bottom": {"model": "lambertian", "reflectance": 0.2}}, FEATURE_RADIANCE | FEATURE_BOTTOM),
-    ({"bottom": {"model": "black"}, "tallies.nadir_estimator": "local"},
-     FEATURE_RADIANCE | FEATURE_ESTIMATES),
+    ({"tallies.radiance": False}, set()),
+    ({}, {"radiance"}),
+    ({"illumination.diffuse_fraction": 0.3}, {"radiance", "sky"}),
+    ({"bottom": {"model": "lambertian", "reflectance": 0.2}}, {"radiance", "bottom"}),
+    ({"bottom": {"model": "black"}, "tallies.nadir_estimator": "local"}, {"radiance", "cap"}),
     ({"tallies.radiance": False, "tallies.local_directions_deg": [[180.0, 0.0]]},
-     FEATURE_ESTIMATES),
-    ({"estimator": {"split_weight": 2.0}}, FEATURE_RADIANCE | FEATURE_SPLITTING),
-    ({"estimator": {"upward_fraction": 0.1}}, FEATURE_RADIANCE | FEATURE_UPWARD),
+     {"directions"}),
+    ({"estimator": {"split_weight": 2.0}}, {"radiance", "splitting"}),
+    ({"estimator": {"upward_fraction": 0.1}}, {"radiance", "upward"}),
 ])
-def test_features_follow_the_scene(changes, expected):
-    sc, _ = scene.build(config(**changes))
-    assert features_of(sc) == expected
+def test_switches_follow_the_scene(changes, expected):
+    assert switches(scene.build(config(**changes))) == expected
 
 
 def _same_except(a, b, skip):
