@@ -5,12 +5,47 @@
     result = oceanmc.simulate(config)
     result["Ed"], result.stderr("Ed")
     result.save("out.h5"); oceanmc.load_result("out.h5")
+
+The names below are imported on first use (PEP 562), so that `import oceanmc` and commands that
+need little (`oceanmc --help`) do not pay for numba, h5py and pydantic.
 """
+from typing import TYPE_CHECKING
+
 __version__ = "0.1.0"
 
-from .config import ConfigError, SceneConfig, load_config  # noqa: E402
-from .results import Result, load_result  # noqa: E402
-from .simulation import simulate  # noqa: E402
+# public name -> the submodule that defines it
+_LAZY = {
+    "ConfigError": "config",
+    "SceneConfig": "config",
+    "load_config": "config",
+    "Result": "results",
+    "load_result": "results",
+    "simulate": "simulation",
+}
+# submodules that `import oceanmc` used to import (directly or not) and so made attributes
+_SUBMODULES = frozenset({"config", "results", "simulation", "scene", "kernel", "brdf_tables",
+                         "phase_tables", "sky_maps", "cap_tables"})
 
 __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result", "simulate",
            "__version__"]
+
+if TYPE_CHECKING:
+    from .config import ConfigError, SceneConfig, load_config
+    from .results import Result, load_result
+    from .simulation import simulate
+
+
+def __getattr__(name: str):
+    from importlib import import_module
+
+    if name in _LAZY:
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in _SUBMODULES:
+        return import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY) | _SUBMODULES)

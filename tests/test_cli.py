@@ -86,6 +86,24 @@ def test_missing_config_and_bad_options(tmp_path):
     assert done.returncode == 2
 
 
+def test_help_does_not_import_the_heavy_modules(tmp_path):
+    """`oceanmc --help` (run as `python -m oceanmc --help`) imports neither the kernel (numba),
+    the results file (h5py) nor the schema (pydantic): commands that need little start fast."""
+    heavy = ("numba", "h5py", "pydantic")
+    code = ("import runpy, sys\n"
+            "sys.argv = ['oceanmc', '--help']\n"
+            "try:\n"
+            "    runpy.run_module('oceanmc', run_name='__main__', alter_sys=True)\n"
+            "except SystemExit as exc:\n"
+            "    assert exc.code == 0, exc.code\n"
+            f"print('imported:', *sorted(m for m in {heavy!r} if m in sys.modules))\n")
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=ENV,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "usage: oceanmc" in done.stdout
+    assert done.stdout.strip().splitlines()[-1] == "imported:"
+
+
 def test_existing_results_are_not_overwritten_without_the_flag(tmp_path, scene_file):
     target = tmp_path / "r.h5"
     target.write_bytes(b"precious")

@@ -1,0 +1,39 @@
+"""Scene configuration: schema, defaults and validation.
+
+A scene is read from YAML (or a dict), checked against the schema and resolved into a
+`SceneConfig` (pydantic models). Every problem is reported as one `ConfigError` that names the key
+path, the offending value and what is allowed; nothing downstream sees an unchecked value.
+
+The schema, by component: base (ConfigError, the strict base model, number types), phase, water,
+illumination, surface, bottom, tallies, estimator, scene (SceneConfig and the checks across
+components); loading (load_config, config_to_yaml). Every name is re-exported here.
+"""
+from .base import Asymmetry, ConfigError, Finite, Fraction, NonNegative, _Strict
+from .bottom import (BlackBottom, Bottom, GGXBottom, HapkeBottom, LambertianBottom,
+                     LambertianSpecularBottom, MinnaertBottom, NoBottom, Sampling, SpecularBottom,
+                     TableBottom, bottom_has_mirror, bottom_weight_bounded)
+from .estimator import Estimator
+from .illumination import Illumination, SkyMap
+from .loading import _describe, _key_path, _resolve_files, config_to_yaml, load_config
+from .phase import (BasicPhase, FournierForand, HenyeyGreenstein, Isotropic, Mixture,
+                    MixtureComponent, Petzold, Phase, PureWater, Rayleigh, TablePhase, TwoTermHG)
+from .scene import SceneConfig
+from .surface import Surface
+from .tallies import HYDROLIGHT_THETA_EDGES_DEG, Tallies
+from .water import Layer, Water
+
+__all__ = [
+    "ConfigError", "Finite", "NonNegative", "Fraction", "Asymmetry",
+    "Isotropic", "Rayleigh", "PureWater", "HenyeyGreenstein", "TwoTermHG", "FournierForand",
+    "Petzold", "TablePhase", "BasicPhase", "MixtureComponent", "Mixture", "Phase",
+    "Layer", "Water",
+    "SkyMap", "Illumination",
+    "Surface",
+    "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",
+    "SpecularBottom", "LambertianSpecularBottom", "GGXBottom", "HapkeBottom", "TableBottom",
+    "Bottom", "bottom_has_mirror", "bottom_weight_bounded",
+    "HYDROLIGHT_THETA_EDGES_DEG", "Tallies",
+    "Estimator",
+    "SceneConfig",
+    "load_config", "config_to_yaml",
+]

@@ -1,0 +1,77 @@
+"""SceneConfig: the whole scene, and the checks that involve more than one of its parts."""
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+from pydantic import Field, model_validator
+
+from .base import _Strict
+from .bottom import Bottom, bottom_has_mirror, bottom_weight_bounded
+from .estimator import Estimator
+from .illumination import Illumination
+from .surface import Surface
+from .tallies import Tallies
+from .water import Water
+
+
+class SceneConfig(_Strict):
+    name: str = "oceanmc scene"
+    photons: Annotated[int, Field(gt=0, le=10**13)] = 1_000_000
+    seed: Annotated[int, Field(ge=0, lt=2**63)] = 1
+    batches: Annotated[int, Field(ge=2, le=100_000)] = 32
+    illumination: Illumination = Field(default_factory=Illumination)
+    surface: Surface = Field(default_factory=Surface)
+    water: Water
+    bottom: Bottom
+    tallies: Tallies = Field(default_factory=Tallies)
+    estimator: Estimator = Field(default_factory=Estimator)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "SceneConfig":
+        deep = math.isinf(self.water.layers[-1].thickness_m)
+        if deep and self.bottom.model != "none":
+            raise ValueError(f"bottom.model = {self.bottom.model!r} below an infinitely deep last "
+                             "layer: use bottom.model = 'none'")
+        if not deep and self.bottom.model == "none":
+            raise ValueError("bottom.model = 'none' needs an infinitely deep last layer "
+                             "(thickness_m: .inf); a finite water column needs a bottom "
+                             "(black, lambertian, minnaert, specular, lambertian_specular, "
+                             "ggx, hapke, table)")
+        depth = self.water.depth_m
+        for d in self.tallies.depths_m:
+            if d > depth * (1.0 + 1e-12):
+                raise ValueError(f"tallies.depths_m contains {d} m, below the bottom at "
+                                 f"{depth} m; allowed: 0 <= depth <= {depth}")
+        if self.photons < 2 * self.batches:
+            raise ValueError(f"photons = {self.photons}: need at least 2 per batch "
+                             f"(batches = {self.batches})")
+        if self.tallies.nadir_estimator == "local" and bottom_has_mirror(self.bottom):
+            raise ValueError(f"tallies.nadir_estimator = 'local' with bottom.model = "
+                             f"{self.bottom.model!r}: a mirror has no density for a local "
+                             "estimate; use 'crossing' or 'auto'")
+        if self.tallies.local_directions_deg and bottom_has_mirror(self.bottom):
+            raise ValueError(f"tallies.local_directions_deg with bottom.model = "
+                             f"{self.bottom.model!r}: a mirror has no density for a local "
+                             "estimate; use the quad radiances")
+        if self.estimator.mode == "analog" and self.estimator.upward_fraction is not None:
+            raise ValueError(f"estimator.upward_fraction = {self.estimator.upward_fraction} "
+                             "with estimator.mode = 'analog': the biased scattering changes "
+                             "weights, which the analog walk keeps at 1; use "
+                             "estimator.mode = 'implicit' or upward_fraction: null")
+        if self.estimator.mode == "analog" and not bottom_weight_bounded(self.bottom):
+            raise ValueError(f"estimator.mode = 'analog' with bottom.model = "
+                             f"{self.bottom.model!r} sampled by weight f cos/pdf, which can "
+                             "exceed 1: analog bottom reflection (survival with probability = "
+                             "weight) cannot carry it; use estimator.mode = 'implicit'")
+        return self
+
+    @property
+    def nadir_local(self) -> bool:
+        """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
+        mode = self.tallies.nadir_estimator
+        return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom))
+
+    @property
+    def n_water(self) -> float:
+        return self.surface.n_water if self.surface.model == "flat" else 1.0
