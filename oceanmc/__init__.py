@@ -18,21 +18,21 @@ _LAZY = {
     "ConfigError": "config",
     "SceneConfig": "config",
     "load_config": "config",
-    "Result": "results",
-    "load_result": "results",
-    "simulate": "simulation",
+    "Result": "run.results",
+    "load_result": "run.hdf5",
+    "simulate": "run.simulation",
 }
-# submodules that `import oceanmc` used to import (directly or not) and so made attributes
-_SUBMODULES = frozenset({"config", "results", "simulation", "scene", "kernel", "brdf_tables",
-                         "phase_tables", "sky_maps", "cap_tables"})
+# the subpackages, as attributes (the data flow: config -> scene -> kernel -> run)
+_SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run"})
 
 __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result", "simulate",
            "__version__"]
 
 if TYPE_CHECKING:
     from .config import ConfigError, SceneConfig, load_config
-    from .results import Result, load_result
-    from .simulation import simulate
+    from .run.hdf5 import load_result
+    from .run.results import Result
+    from .run.simulation import simulate
 
 
 def __getattr__(name: str):

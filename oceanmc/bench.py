@@ -33,7 +33,7 @@ import numpy as np
 
 from .config import load_config
 from .kernel.surface.fresnel import fresnel
-from .simulation import simulate
+from .run.simulation import simulate
 
 
 @dataclass

@@ -87,8 +87,10 @@ class StopRequest:
 
 def cmd_run(args: argparse.Namespace) -> int:
     from .config import ConfigError, config_to_yaml, load_config
-    from .results import MergeError, format_summary, load_result, merge_results
-    from .simulation import simulate
+    from .run.hdf5 import load_result
+    from .run.results import MergeError, format_summary, merge_results
+    from .run.compiling import CompileInterrupted
+    from .run.simulation import simulate
 
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
@@ -141,6 +143,12 @@ def cmd_run(args: argparse.Namespace) -> int:
             return 2
         except MergeError as exc:
             raise UsageError(f"--resume: {exc}") from None
+        except CompileInterrupted:
+            # the compilation goes on in its own thread inside LLVM; leave at once, no file
+            print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
+                  "nothing was traced and no file was written", file=sys.stderr, flush=True)
+            sys.stdout.flush()
+            os._exit(130)
         result.attrs["config_file"] = str(path)
         result.save(out)
         print(format_summary(result))
@@ -158,7 +166,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_merge(args: argparse.Namespace) -> int:
-    from .results import MergeError, format_summary, load_result, merge_results
+    from .run.hdf5 import load_result
+    from .run.results import MergeError, format_summary, merge_results
 
     out = Path(args.output)
     parts = []
@@ -182,7 +191,8 @@ def cmd_merge(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
-    from .results import format_summary, load_result
+    from .run.hdf5 import load_result
+    from .run.results import format_summary
 
     path = Path(args.file)
     if not path.is_file():

@@ -5,7 +5,7 @@ import pytest
 import xarray as xr
 
 import oceanmc
-from oceanmc.results import save_result
+from oceanmc.run.hdf5 import save_result
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +85,7 @@ def test_failed_write_leaves_no_file(result, tmp_path, monkeypatch):
 
     def explode(*args, **kwargs):
         raise RuntimeError("disk full")
-    monkeypatch.setattr("oceanmc.results._write", explode)
+    monkeypatch.setattr("oceanmc.run.hdf5._write", explode)
     with pytest.raises(RuntimeError):
         save_result(result, target)
     assert list(tmp_path.iterdir()) == []

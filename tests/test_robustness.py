@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 import oceanmc
-from oceanmc.results import MergeError, merge_results
+from oceanmc.run.results import MergeError, merge_results
 
 from conftest import REPO
 

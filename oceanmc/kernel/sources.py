@@ -4,10 +4,9 @@ proportion to their contribution to the downward plane irradiance just above the
 import math
 
 import numpy as np
-from numba import njit
 
 from .brdf.general import first_above
-from .compile import kernel
+from .compile import kernel, setup
 from .geometry import from_angles
 from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP, SKY_MAP_COSINE
 
@@ -79,7 +78,7 @@ def sky_direction(sky, sf):
     return ux, uy, uz, 1.0
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def sky_many(sky_record, sf, n, seed):
     """Rows (ux, uy, uz, weight factor) of n sky photons from seed (tests and reports)."""
     np.random.seed(seed)

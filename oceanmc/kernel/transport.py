@@ -28,11 +28,10 @@ are reproduced bit for bit (benchmarks/regression.md).
 import math
 
 import numpy as np
-from numba import njit
 
 from . import local_estimate, upward
 from .brdf import dispatch as brdf
-from .compile import internal
+from .compile import batch, internal
 from .geometry import turn
 from .models import (BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, BUDGET_SURFACE_REFLECTION,
                      BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
@@ -307,7 +306,7 @@ def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level):
     return survives_roulette(ctrl, p), n_stacked
 
 
-@njit(error_model="numpy", cache=True, nogil=True, _nrt=False)
+@batch
 def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
                 est_row, ef, ei, ctrl_row, n_photons, seed, tally, packet_row, stack):
     """One batch: its own random stream (seeded from (seed, batch) by the caller; Numba's

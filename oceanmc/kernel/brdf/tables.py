@@ -1,16 +1,16 @@
-"""Compiled loops run once per scene (brdf_tables.py) or by tests, never in the photon loop:
+"""Compiled loops run once per scene (scene/brdf_tables.py) or by tests, never in the photon loop:
 integrals of f cos over outgoing cells for a grid of incident directions (the general sampler's
 tables and the energy check), f at pairs of directions both ways (the reciprocity check), and
 batches of samples, values and densities."""
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compile import setup
 from .dispatch import evaluate_local, pdf_local, sample_local
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def cell_integrals(model, params, theta_i, phi_i, n_t, n_p, gx, gw):
     """out[a, b, c, r] = integral of f(wi_ab, wo) cos(theta_o) over the outgoing cell (dphi band
     c of n_p over [0, 2 pi) relative to phi_i[b], theta_o band r of n_t over [0, pi/2]), with a
@@ -55,7 +55,7 @@ def cell_integrals(model, params, theta_i, phi_i, n_t, n_p, gx, gw):
     return out, f_min, where
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def both_ways(model, params, wi, wo):
     """(f(wi_k, wo_k), f(wo_k, wi_k)) for rows of unit vectors wi, wo (n, 3)."""
     n = wi.shape[0]
@@ -68,7 +68,7 @@ def both_ways(model, params, wi, wo):
     return out
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def sample_many(model, params, wix, wiy, wiz, u1, u2):
     """Rows (wox, woy, woz, weight) of sample_local for one incidence and arrays of randoms."""
     n = u1.shape[0]
@@ -82,7 +82,7 @@ def sample_many(model, params, wix, wiy, wiz, u1, u2):
     return out
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def f_and_pdf(model, params, wix, wiy, wiz, wo):
     """Rows (f, pdf) at the outgoing directions wo (n, 3) for one incidence."""
     n = wo.shape[0]

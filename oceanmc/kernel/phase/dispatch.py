@@ -4,9 +4,8 @@ are comp_start .. comp_start + comp_count - 1 in the medium's pools (kernel/reco
 import math
 
 import numpy as np
-from numba import njit
 
-from ..compile import kernel
+from ..compile import kernel, setup
 from ..models import PHASE_HG, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
@@ -77,7 +76,7 @@ def evaluate(medium, mf, mi, layer, cos_psi):
     return total
 
 
-@njit(error_model="numpy", cache=True)
+@setup
 def layer_density(medium, mf, mi, layer, angles):
     """q(psi) = 2 pi p(psi) sin(psi) of the layer's phase function at each angle (rad), for
     tables built once per scene; tabulated components are read exactly, without the loss of

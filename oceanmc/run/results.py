@@ -1,4 +1,4 @@
-"""Result: per-batch tallies turned into means and standard errors, and their HDF5 form.
+"""Result: per-batch tallies turned into means and standard errors (hdf5.py writes and reads it).
 
 Every quantity keeps its per-batch values (leading `batch` axis); the estimate is the mean over
 batches and its standard error the sample standard deviation over sqrt(batches). Because the
@@ -7,17 +7,12 @@ batch values are stored, results of independent runs merge by concatenating batc
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 
-from .kernel import models
-
-FORMAT_VERSION = 1
+from ..kernel import models
 
 
 @dataclass
@@ -60,6 +55,7 @@ class Result:
         return str(self.attrs["config_yaml"])
 
     def save(self, path: str | Path) -> Path:
+        from .hdf5 import save_result
         return save_result(self, path)
 
 
@@ -267,123 +263,6 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     attrs = dict(attrs)
     attrs["Lu_method"] = lu_method
     return Result(coords, q, attrs)
-
-
-# --- HDF5 --------------------------------------------------------------------------------------
-
-COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is 0- "
-                               "(just below the surface)"),
-               "theta": ("deg", "polar angle of the direction of travel from nadir, band centre"),
-               "phi": ("deg", "azimuth of travel from the sun's travel azimuth, band centre"),
-               "theta_edges": ("deg", "theta band edges"),
-               "phi_edges": ("deg", "phi band edges"),
-               "batch": ("1", "independent batch index"),
-               "direction": ("1", "index of a local-estimate direction"),
-               "direction_theta": ("deg", "theta of travel of each local-estimate direction"),
-               "direction_phi": ("deg", "phi of travel of each local-estimate direction")}
-
-
-AUXILIARY_COORDS = {"direction_theta": "direction", "direction_phi": "direction"}
-
-
-def _write_attrs(obj, attrs: dict) -> None:
-    for key, value in attrs.items():
-        if value is None:
-            continue
-        obj.attrs[key] = value
-
-
-def save_result(result: Result, path: str | Path) -> Path:
-    """Writes the result atomically: a temporary file in the same folder, renamed into place."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as f:
-            _write(f, result)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 is for the temporary name only
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def _write(f: h5py.File, result: Result) -> None:
-    """Each group holds the coordinates its variables use, as dimension scales, so that
-    xarray.open_dataset(path, engine="h5netcdf", group=...) names every dimension."""
-    _write_attrs(f, result.attrs)
-    f.attrs["format_version"] = FORMAT_VERSION
-    n_batches = next(iter(result.quantities.values())).batches.shape[0]
-    coords = dict(result.coords, batch=np.arange(n_batches))
-    scales: dict[tuple[str, str], h5py.Dataset] = {}
-
-    def scale(group: str, dim: str) -> h5py.Dataset:
-        if (group, dim) not in scales:
-            ds = f.require_group(group or "/").create_dataset(dim, data=coords[dim])
-            ds.make_scale(dim)
-            ds.attrs["units"], ds.attrs["description"] = COORD_UNITS[dim]
-            scales[group, dim] = ds
-        return scales[group, dim]
-
-    def write(name: str, values: np.ndarray, dims: tuple[str, ...], units: str, desc: str,
-              **options) -> h5py.Dataset:
-        ds = f.create_dataset(name, data=values, **options)
-        ds.attrs["units"] = units
-        ds.attrs["description"] = desc
-        group = name.rpartition("/")[0]
-        for axis, dim in enumerate(dims):
-            ds.dims[axis].attach_scale(scale(group, dim))
-        return ds
-
-    for name, values in result.coords.items():
-        if name in AUXILIARY_COORDS:
-            write(name, values, (AUXILIARY_COORDS[name],), *COORD_UNITS[name])
-        else:
-            scale("", name)
-    for q in result.quantities.values():
-        write(q.name, q.mean, q.dims, q.units, q.description)
-        write(q.name + "_stderr", q.stderr, q.dims, q.units,
-              f"standard error of {q.name} over batches")
-        ds = write("batches/" + q.name, q.batches, ("batch",) + q.dims, q.units,
-                   f"per-batch values of {q.name}", compression="gzip", compression_opts=4,
-                   shuffle=True)
-        ds.attrs["dims"] = ",".join(q.dims)
-
-
-def load_result(path: str | Path) -> Result:
-    """Reads a results file written by Result.save back into the same Result."""
-    path = Path(path)
-    with h5py.File(path, "r") as f:
-        attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
-        coords = {name: f[name][()] for name in COORD_UNITS if name != "batch"}
-        quantities = {}
-
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                if "dims" not in obj.attrs:
-                    return  # a coordinate of the batches group
-                quantities[name] = Quantity(name, dims_of(obj), obj[()],
-                                            _plain(obj.attrs["units"]),
-                                            _plain(f[name].attrs["description"]))
-        f["batches"].visititems(visit)
-    return Result(coords, quantities, attrs)
-
-
-def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:
-    return tuple(d for d in _plain(dataset.attrs["dims"]).split(",") if d)
-
-
-def _plain(value):
-    if isinstance(value, bytes):
-        return value.decode("utf-8")
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
 
 
 # --- the printed summary -----------------------------------------------------------------------

@@ -3,83 +3,21 @@ compiled kernel (a progress bar between groups), and hands the tallies to result
 from __future__ import annotations
 
 import math
-import sys
-import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, Callable
 
 import numba
-from numba.core.config import _OptLevel
 import numpy as np
 from tqdm import tqdm
 
-from . import __version__, scene
-from .config import SceneConfig, config_to_yaml, load_config
-from .kernel import CACHE_DIR
-from .kernel.records import PACKET, SPLIT_STACK_ROWS
-from .kernel.transport import trace_batch
+from .. import __version__, scene
+from ..config import SceneConfig, config_to_yaml, load_config
+from ..kernel.records import PACKET, SPLIT_STACK_ROWS
+from ..scene.grid import tally_views
+from .compiling import CompileInterrupted, ready
 from .results import Result, from_tallies
-from .scene.grid import tally_views
-
-
-class CompileInterrupted(Exception):
-    """The user asked to stop while the photon loop was compiling; nothing was traced."""
-
-
-COMPILE_NOTICE_AFTER_S = 1.0
-# LLVM's optimisation level for the photon loop's IR (machine code is still generated at
-# Numba's default level): level 1 keeps the inlining of the event functions and compiles the
-# loop in 0.74 of the time of level 3, with as many photons/s (benchmarks/bench.md)
-KERNEL_OPT_LEVEL = 1
-
-
-def compiled_batch(args: tuple, should_stop: Callable[[], bool] | None = None):
-    """trace_batch compiled for these argument types, or loaded from the disk cache. Every scene
-    has the same types, so this compiles once per kernel version and machine. The compilation
-    runs in a helper thread (LLVM releases the GIL) so that the main thread can say what is
-    happening every few seconds on stderr and stop at once on Ctrl-C (KeyboardInterrupt) or
-    when should_stop() says so (CompileInterrupted)."""
-    if not hasattr(trace_batch, "overloads"):  # NUMBA_DISABLE_JIT=1: plain Python
-        return trace_batch
-    signature = tuple(numba.typeof(a) for a in args)
-    if signature not in trace_batch.overloads:
-        failure = []
-
-        def compile_it():
-            previous = numba.config.OPT
-            numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
-            try:
-                trace_batch.compile(signature)
-            except BaseException as exc:  # handed to the main thread
-                failure.append(exc)
-            finally:
-                numba.config.OPT = previous
-
-        worker = threading.Thread(target=compile_it, name="oceanmc-compile", daemon=True)
-        t0 = time.perf_counter()
-        worker.start()
-        said = 0.0
-        while worker.is_alive():
-            worker.join(0.1)
-            if should_stop is not None and should_stop():
-                raise CompileInterrupted("stopped while compiling the photon loop")
-            elapsed = time.perf_counter() - t0
-            if worker.is_alive() and elapsed >= COMPILE_NOTICE_AFTER_S and elapsed - said >= 5.0:
-                if not said:
-                    print(f"oceanmc: compiling the photon loop (once per oceanmc version on this "
-                          f"machine; cached in {CACHE_DIR})", file=sys.stderr, flush=True)
-                else:
-                    print(f"oceanmc: still compiling, {elapsed:.0f} s", file=sys.stderr,
-                          flush=True)
-                said = elapsed
-        if failure:
-            raise failure[0]
-        if said:
-            print(f"oceanmc: photon loop compiled in {time.perf_counter() - t0:.1f} s",
-                  file=sys.stderr, flush=True)
-    return trace_batch.overloads[signature].entry_point
 
 
 def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
@@ -118,6 +56,10 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     # number of cores) is the default and the most
     n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
         else max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    t0 = time.perf_counter()
+    # compiles the kernel (or loads it from the cache) before the scene is packed, which uses it
+    trace = ready(should_stop)
+    startup = time.perf_counter() - t0
     sc = scene.build(config)
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
@@ -136,10 +78,6 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     def batch(b: int) -> tuple:
         return (n_per_batch, seeds[b], tallies[b], packets[b:b + 1], stacks[b])
 
-    t0 = time.perf_counter()
-    # compiles the loop (or loads it from the cache) outside the timing
-    trace = compiled_batch(sc.kernel_args() + batch(0), should_stop)
-    startup = time.perf_counter() - t0
 
     def run_batch(b: int) -> None:
         events[b] = trace(*sc.kernel_args(), *batch(b))
