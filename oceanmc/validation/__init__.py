@@ -9,8 +9,9 @@ out_dir/report.md, out_dir/figures/*.png and out_dir/results.json (a list of rec
 quantity, value, stderr, reference, z, tolerance, pass, and kind, group, ref_error, rel_error,
 rel_stderr, rel_stderr_cap, note). The command line `oceanmc validate [-o DIR] [--quick]` calls it.
 
-Cases (see cases.py, brdf_models.py and the report): brdf_bottom, brdf_models,
-optical_manhole, fresnel, beer_lambert, chandrasekhar, disort, white_furnace, reciprocity.
+Cases (one module each under cases/, shared helpers in cases/common.py, the registry CASES in
+cases/__init__.py; see also the report): brdf_bottom, brdf_models, optical_manhole, fresnel,
+beer_lambert, chandrasekhar, disort, upward_bias, white_furnace, reciprocity.
 
 Running with deliberately changed physics (to show that a check can fail):
 

@@ -21,11 +21,11 @@ from typing import Callable
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
-from . import references as ref
-from .cases import (MU_CUT, _plt, band_labels, clear_layer, edges_of, hemisphere_bands, quads,
-                    scene)
-from .context import Ctx
-from .stats import JK
+from .. import references as ref
+from ..context import Ctx
+from ..stats import JK
+from .common import (MU_CUT, Case, _plt, band_labels, clear_layer, edges_of, hemisphere_bands,
+                     quads, scene)
 
 PANEL_THETA_DEG = 1.0    # quad edges, table nodes (3 and 6 deg) and suns are whole degrees
 PANEL_PHI_DEG = 2.5      # phi band edges (7.5 + 15 j) and table azimuth nodes (5, 10 deg)
@@ -461,3 +461,8 @@ def figure_principal_plane(ctx: Ctx, shown: dict) -> None:
                "the integrated reference quad averages (crosses) and f itself at the exact "
                "directions (line; the Lambertian + mirror quad holding the mirror beam is the "
                "cross far above it).")
+
+
+CASE = Case("brdf_models", "GGX, Hapke, Lambertian + mirror and table bottoms; the general sampler",
+            case_brdf_models, "Eu/Ed vs rho_dh(theta_i) and quad radiance vs quad averages of f, "
+            "both integrated numerically from the models' formulas")
