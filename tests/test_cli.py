@@ -156,3 +156,23 @@ def test_kernel_runs_without_jit(tmp_path, scene_file):
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     assert "budget total" in done.stdout
+
+
+def test_ctrl_c_while_compiling_stops_at_once_without_a_file(tmp_path, scene_file):
+    """With an empty compile cache the run says that it is compiling (what and why); Ctrl-C
+    then ends it within a second, with exit status 130, a clear message and no results file."""
+    import signal
+    import time
+    env = dict(ENV, OCEANMC_CACHE_DIR=str(tmp_path / "empty-cache"))
+    out = tmp_path / "out.h5"
+    proc = subprocess.Popen([sys.executable, "-m", "oceanmc", "run", str(scene_file), "-o",
+                             str(out)], cwd=tmp_path, env=env, stderr=subprocess.PIPE, text=True)
+    notice = proc.stderr.readline()
+    assert "compiling the photon loop" in notice and "once per oceanmc version" in notice
+    proc.send_signal(signal.SIGINT)
+    t0 = time.perf_counter()
+    rest = proc.communicate(timeout=30)[1]
+    assert time.perf_counter() - t0 < 1.0
+    assert proc.returncode == 130
+    assert "while compiling the photon loop" in rest and "no file was written" in rest
+    assert not out.exists() and not list(tmp_path.glob(".out.h5.*"))

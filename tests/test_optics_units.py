@@ -178,6 +178,55 @@ def test_schlick_is_not_the_default():
     assert surface["model"] == models.SURFACE_FLAT and surface["n_water"] == 1.34
 
 
+# --- the surface as a BSDF (kernel/surface/) ------------------------------------------------
+
+def surface_record(model="flat", n=1.34, schlick=0):
+    from oceanmc import registry
+    from oceanmc.kernel import records
+    return records.record(records.SURFACE, model=registry.surface_id(model), n_water=n,
+                          schlick=schlick)[0]
+
+
+@pytest.mark.parametrize("theta_deg, up", [(0.0, False), (40.0, False), (85.0, False),
+                                           (20.0, True), (47.0, True), (60.0, True)])
+def test_flat_surface_sample_chooses_by_fresnel_with_unit_weight(theta_deg, up):
+    """sample(): reflection for u < R (exact Fresnel from the air or the water), the mirror or
+    Snell direction, weight f cos / pdf = 1 either way; split() gives the same R and both
+    directions, and reflected + transmitted shares add up to 1 (energy conservation)."""
+    from oceanmc.kernel.surface import dispatch
+    surface = surface_record()
+    t = math.radians(theta_deg)
+    ux, uy, uz = math.sin(t), 0.0, (-1.0 if up else 1.0) * math.cos(t)
+    n1, n2 = (1.34, 1.0) if up else (1.0, 1.34)
+    r_ref, cos_t = fresnel(n1, n2, abs(uz))
+    r, rx, ry, rz, tx, ty, tz = dispatch.split(surface, ux, uy, uz)
+    assert r == pytest.approx(r_ref, abs=1e-15)
+    assert (rx, ry, rz) == pytest.approx((ux, uy, -uz), abs=1e-15)
+    u = (np.arange(20_000) + 0.5) / 20_000
+    picks = [dispatch.sample(surface, ux, uy, uz, v) for v in u]
+    reflected = np.array([not p[4] for p in picks])
+    assert all(p[3] == 1.0 for p in picks)
+    assert reflected.mean() == pytest.approx(r_ref, abs=1e-4)
+    if r_ref < 1.0:
+        ox, oy, oz = next(p[:3] for p in picks if p[4])
+        assert n1 * math.sin(t) == pytest.approx(n2 * math.hypot(ox, oy), rel=1e-12)
+        assert math.copysign(1.0, oz) == math.copysign(1.0, uz)
+    else:
+        assert reflected.all()   # total internal reflection (48.3 deg from the water)
+    assert dispatch.evaluate(surface, ux, uy, uz, rx, ry, rz) == 0.0   # a delta BSDF
+    assert dispatch.pdf(surface, ux, uy, uz, rx, ry, rz) == 0.0
+
+
+def test_surface_transmittance_for_local_estimates():
+    """What the local estimates ask of the surface: 1 - R from the water for the flat surface
+    (0 beyond the critical angle), 1 without an interface."""
+    from oceanmc.kernel.surface import dispatch
+    for mu in (1.0, 0.9, 0.7, 0.66, 0.5, 0.1):
+        assert dispatch.transmittance(surface_record(), mu) == pytest.approx(
+            1.0 - fresnel(1.34, 1.0, mu)[0], abs=1e-15)
+        assert dispatch.transmittance(surface_record("none", 1.0), mu) == 1.0
+
+
 # --- direction geometry ----------------------------------------------------------------------
 
 def test_turn_keeps_the_scattering_angle():

@@ -22,7 +22,10 @@ F8 = np.float64
 
 
 def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
-    return np.dtype([(name, I8 if name in ints else F8) for name in fields], align=True)
+    """A record dtype whose scalars are np.record (attribute access, also in plain Python under
+    NUMBA_DISABLE_JIT=1); to Numba the same type as the plain structured dtype."""
+    return np.dtype((np.record, np.dtype([(name, I8 if name in ints else F8) for name in fields],
+                                         align=True)))
 
 
 # Water column: planes (surface first, then layer boundaries and tally depths, bottom last; z =
@@ -101,8 +104,8 @@ ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_event
 
 # A photon packet: position (depth z and the segment it is in or on), weight, direction of
 # travel, whether it still belongs to the collimated solar beam, and its wavelength's index.
-PACKET = np.dtype([("z", F8), ("w", F8), ("ux", F8), ("uy", F8), ("uz", F8), ("seg", I8),
-                   ("beam", I8), ("wavelength", I8)], align=True)
+PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength",
+                 ints=("seg", "beam", "wavelength"))
 
 # Rows on the split stack of one batch (kernel/transport.py)
 SPLIT_STACK_ROWS = 64
