@@ -2,6 +2,7 @@
 
     python benchmarks/regression.py record OUT.npz [--configs configs] [--cases all]
     python benchmarks/regression.py compare BEFORE.npz AFTER.npz [-o benchmarks/regression.md]
+        [--labels "commit c077515" "commit abc1234"]
 
 `record` runs, with fixed seeds, every shipped config (configs/*.yaml, at its own photon count)
 and every scene of every validation case (quick mode: the case's own seeds), and stores each
@@ -73,7 +74,8 @@ def record(out: Path, configs_dir: Path, cases: list[str] | None) -> int:
     return 0
 
 
-def compare(before_path: Path, after_path: Path, report: Path | None) -> int:
+def compare(before_path: Path, after_path: Path, report: Path | None,
+            labels: tuple[str, str] = ("before", "after")) -> int:
     before = np.load(before_path)
     after = np.load(after_path)
     keys = sorted({k.rsplit("|", 1)[0] for k in before.files})
@@ -113,6 +115,10 @@ def compare(before_path: Path, after_path: Path, report: Path | None) -> int:
         "# Regression comparison: kernel before and after",
         "",
         f"`python benchmarks/regression.py compare {before_path.name} {after_path.name}`",
+        "",
+        f"Before: {labels[0]}. After: {labels[1]}. Every shipped config (configs/*.yaml, at its "
+        "own photon count and seed) and every scene of every validation case (quick mode, the "
+        "cases' own seeds), recorded with `python benchmarks/regression.py record FILE.npz`.",
         "",
         f"- scene quantities compared: {len(rows)} ({len(keys)} before, {len(keys_after)} after;"
         f" missing after: {len(missing)}, new after: {len(extra)})",
@@ -156,11 +162,13 @@ def main(argv: list[str] | None = None) -> int:
     cmp_.add_argument("before", type=Path)
     cmp_.add_argument("after", type=Path)
     cmp_.add_argument("-o", "--report", type=Path, default=None)
+    cmp_.add_argument("--labels", nargs=2, default=("before", "after"),
+                      help="what the two recordings are (e.g. the commits)")
     args = parser.parse_args(argv)
     if args.command == "record":
         cases = None if args.cases == "all" else [c for c in args.cases.split(",") if c]
         return record(args.out, args.configs, cases)
-    return compare(args.before, args.after, args.report)
+    return compare(args.before, args.after, args.report, tuple(args.labels))
 
 
 if __name__ == "__main__":

@@ -100,25 +100,18 @@ def inverse_mu(uz, mu_cut, beam):
 
 
 @internal
-def score_crossing(grid, gf, gi, tally, level, second, w, ux, uy, uz, beam):
-    """A crossing of tally level `level` (an in-water depth, or the air levels after them), and
-    of level `second` too when second >= 0 (the same crossing counted twice: the bands are found
-    once); beam: the packet is still part of the collimated solar beam."""
+def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
+    """A crossing of tally level `level` (an in-water depth, or one of the air levels after
+    them); beam: the packet is still part of the collimated solar beam."""
     w_over_mu = w * inverse_mu(uz, grid.mu_cut, beam)
-    col_e = FLUX_ED if uz > 0.0 else FLUX_EU
-    col_eo = FLUX_EOD if uz > 0.0 else FLUX_EOU
     at = grid.flux + 4 * level
-    tally[at + col_e] += w
-    tally[at + col_eo] += w_over_mu
-    if second >= 0:
-        at = grid.flux + 4 * second
-        tally[at + col_e] += w
-        tally[at + col_eo] += w_over_mu
+    if uz > 0.0:
+        tally[at + FLUX_ED] += w
+        tally[at + FLUX_EOD] += w_over_mu
+    else:
+        tally[at + FLUX_EU] += w
+        tally[at + FLUX_EOU] += w_over_mu
     if grid.radiance_on:
         band = theta_band_fast(grid, gf, gi, uz)
         col = 0 if gi[grid.theta_is_cap + band] else phi_band_fast(grid, gf, ux, uy)
-        quad = band * grid.phi_cols + col
-        per_level = grid.theta_cols * grid.phi_cols
-        tally[grid.radiance + level * per_level + quad] += w_over_mu
-        if second >= 0:
-            tally[grid.radiance + second * per_level + quad] += w_over_mu
+        tally[grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col] += w_over_mu

@@ -57,14 +57,15 @@ def exponential():
 
 @internal
 def launch(p, w, ux, uy, uz, beam):
-    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz)."""
+    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz);
+    beam: it belongs to the collimated solar beam."""
     p.z = 0.0
     p.seg = 0
     p.w = w
     p.ux = ux
     p.uy = uy
     p.uz = uz
-    p.beam = beam
+    p.beam = 1 if beam else 0
 
 
 @internal
@@ -115,24 +116,25 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
     implicit mode the whole solar beam of a batch enters in one call."""
     air = grid.air_level
     w = p.w
-    score_crossing(grid, gf, gi, tally, air, -1, w, p.ux, p.uy, p.uz, p.beam)
+    score_crossing(grid, gf, gi, tally, air, w, p.ux, p.uy, p.uz, p.beam)
     r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
-    budget = grid.budget
     if ctrl.analog:
-        if r > 0.0 and np.random.random() < r:
-            score_crossing(grid, gf, gi, tally, air, -1, w, rx, ry, rz, p.beam)
-            tally[budget + BUDGET_SURFACE_REFLECTION] += w
-            return False
+        reflected = r > 0.0 and np.random.random() < r
+        w_reflected = w if reflected else 0.0
     else:
-        if r > 0.0:
-            score_crossing(grid, gf, gi, tally, air, -1, w * r, rx, ry, rz, p.beam)
-            tally[budget + BUDGET_SURFACE_REFLECTION] += w * r
+        reflected = False
+        w_reflected = w * r
         p.w = w * (1.0 - r)
+    if w_reflected > 0.0:
+        score_crossing(grid, gf, gi, tally, air, w_reflected, rx, ry, rz, p.beam)
+        tally[grid.budget + BUDGET_SURFACE_REFLECTION] += w_reflected
+    if reflected:
+        return False
     p.ux = tx
     p.uy = ty
     p.uz = tz
     if grid.surface_level >= 0:
-        score_crossing(grid, gf, gi, tally, grid.surface_level, -1, p.w, tx, ty, tz, p.beam)
+        score_crossing(grid, gf, gi, tally, grid.surface_level, p.w, tx, ty, tz, p.beam)
     return True
 
 
@@ -229,20 +231,20 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p):
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
     an analog walk). Returns whether the packet goes on."""
     r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
-    air = grid.air_level
     w = p.w
     if ctrl.analog:
-        if r <= 0.0 or np.random.random() >= r:
-            score_crossing(grid, gf, gi, tally, air, air + 1, w, tx, ty, tz, p.beam)
-            tally[grid.budget + BUDGET_WATER_LEAVING] += w
-            return False
+        goes_on = r > 0.0 and np.random.random() < r
+        leaving = 0.0 if goes_on else w
     else:
         leaving = w * (1.0 - r)
-        if leaving > 0.0:
-            score_crossing(grid, gf, gi, tally, air, air + 1, leaving, tx, ty, tz, p.beam)
-            tally[grid.budget + BUDGET_WATER_LEAVING] += leaving
-        if r <= 0.0 or (r < 1.0 and np.random.random() >= r):
-            return False
+        goes_on = r > 0.0 and (r >= 1.0 or np.random.random() < r)
+    if leaving > 0.0:
+        air = grid.air_level
+        score_crossing(grid, gf, gi, tally, air, leaving, tx, ty, tz, p.beam)
+        score_crossing(grid, gf, gi, tally, air + 1, leaving, tx, ty, tz, p.beam)
+        tally[grid.budget + BUDGET_WATER_LEAVING] += leaving
+    if not goes_on:
+        return False
     p.ux = rx
     p.uy = ry
     p.uz = rz
@@ -286,7 +288,7 @@ def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
     the next segment) and the plane's tally level (-1: none)."""
     level = mi[medium.plane_tally + target]
     if level >= 0:
-        score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if target == 0:
         return PLANE_SURFACE, level
     if target == medium.n_planes - 1:
@@ -300,7 +302,7 @@ def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
-        score_crossing(grid, gf, gi, tally, level, -1, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
         n_stacked = split(ctrl, stack, n_stacked, p)
     return survives_roulette(ctrl, p), n_stacked
@@ -332,23 +334,23 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     w_sun_in, sx, sy, sz = 0.0, 0.0, 0.0, 1.0
     if not analog and n_sun > 0:
         # every implicit-mode sun packet enters the same way: score the beam's entry once
-        launch(p, w_sun * n_sun, sky.sun_sin, 0.0, sky.sun_mu, 1)
+        launch(p, w_sun * n_sun, sky.sun_sin, 0.0, sky.sun_mu, n_sun > 0)
         enter_from_air(surface, ctrl, grid, gf, gi, tally, p)
         w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
     events = 0
+    n_stacked = 0   # the split stack is empty between photons
     for i in range(n_photons):
-        from_air = True
-        if i < n_sky:
+        from_sky = i < n_sky
+        if from_sky:
             ux, uy, uz, weight = sky_direction(sky, sf)
-            launch(p, weight * w_sky, ux, uy, uz, 0)
+            w = weight * w_sky
         elif analog:
-            launch(p, w_sun, sky.sun_sin, 0.0, sky.sun_mu, 1)
+            ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun
         else:
-            launch(p, w_sun_in, sx, sy, sz, 1)
-            from_air = False
-        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
+            ux, uy, uz, w = sx, sy, sz, w_sun_in
+        launch(p, w, ux, uy, uz, not from_sky)
+        if (from_sky or analog) and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
             continue
-        n_stacked = 0
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, stack, n_stacked, p)
         while True:
@@ -356,12 +358,13 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
             # loses roulette; then the next of its split copies, if any
             tau = exponential()
             alive = True
+            walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
                 outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau)
                 if outcome == FLIGHT_COLLISION:
-                    events += 1
+                    walk_events += 1
                     alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p,
-                                         where, events)
+                                         where, walk_events)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
                     if plane == PLANE_SURFACE:
@@ -374,6 +377,7 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                                                             n_stacked, p, level)
                 else:
                     alive = False
+            events += walk_events
             if n_stacked == 0:
                 break
             n_stacked -= 1

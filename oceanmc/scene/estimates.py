@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
 from .. import config as cfg
+from ..kernel.compile import CACHE_DIR
 from ..kernel.phase.dispatch import layer_density
 from ..kernel.records import ESTIMATES, Pool, record
 from ..kernel.surface.dispatch import transmittance
@@ -46,6 +50,12 @@ def local_directions(config: cfg.SceneConfig, surface: np.ndarray
 
 
 _CAP_CACHE: dict[bytes, list[np.ndarray]] = {}
+# the moments of each phase function and cap, kept on disk beside the kernel's compile cache
+# (0.5 s of numpy per phase function, the largest part of a cached start otherwise), keyed by
+# the phase function, the geometry and the source of cap_tables.py
+_CAP_DIR = CACHE_DIR.parent / "cap-moments"
+_CAP_FILES_KEPT = 256   # 83 kB each
+_CAP_SOURCE = hashlib.sha1(Path(cap_tables.__file__).read_bytes()).digest()
 
 
 def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) -> bytes:
@@ -67,8 +77,15 @@ def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) ->
 def layer_cap_moments(medium, mf, mi, layer: int, geometry: tuple, alphas: np.ndarray
                       ) -> list[np.ndarray]:
     """[M0, M1] of the water cap and of the air cap's water side for one layer's phase function,
-    remembered within the process by the phase function's content (scenes of a batch, tests)."""
-    key = hashlib.sha1(np.array(geometry).tobytes() + layer_key(medium, mf, mi, layer)).digest()
+    remembered by the phase function's content, within the process and on disk."""
+    key = hashlib.sha1(_CAP_SOURCE + np.array(geometry).tobytes() + alphas.tobytes()
+                       + layer_key(medium, mf, mi, layer)).digest()
+    path = _CAP_DIR / f"{key.hex()}.npy"
+    if key not in _CAP_CACHE and path.exists():
+        try:
+            _CAP_CACHE[key] = list(np.load(path))
+        except (OSError, ValueError):
+            pass   # unreadable: computed again below
     if key not in _CAP_CACHE:
         m = medium[0]
         first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
@@ -80,6 +97,16 @@ def layer_cap_moments(medium, mf, mi, layer: int, geometry: tuple, alphas: np.nd
         table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, psi), breaks)
         _CAP_CACHE[key] = [*cap_tables.cap_moments(table, beta, mu_w, alphas),
                            *cap_tables.cap_moments(table, beta_w, mu_a, alphas)]
+        try:   # atomically, so that a concurrent run never reads half a file
+            _CAP_DIR.mkdir(parents=True, exist_ok=True)
+            with tempfile.NamedTemporaryFile(dir=_CAP_DIR, suffix=".npy", delete=False) as f:
+                np.save(f, np.array(_CAP_CACHE[key]))
+            os.replace(f.name, path)
+            kept = sorted(_CAP_DIR.glob("*.npy"), key=lambda p: p.stat().st_mtime)
+            for old in kept[:-_CAP_FILES_KEPT]:
+                old.unlink(missing_ok=True)
+        except OSError:
+            pass   # a read-only install: the tables are computed in each process
         if len(_CAP_CACHE) > 64:
             _CAP_CACHE.pop(next(iter(_CAP_CACHE)))
     return _CAP_CACHE[key]
