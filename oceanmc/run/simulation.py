@@ -45,9 +45,9 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
              checkpoint_every_s: float = 60.0) -> Result:
     """Runs a scene (a SceneConfig, a dict or a YAML path) and returns its Result.
 
-    Batches first_batch .. batches-1 are traced (a resumed run starts after the batches it
-    already has; batch b is the same whatever the start). Between groups of batches,
-    should_stop() may end the run early: the Result then holds the batches completed and is
+    Batches first_batch .. batches-1 are traced, `threads` at a time (a resumed run starts
+    after the batches it already has; batch b is the same whatever the start). After each
+    batch, should_stop() may end the run early: the Result then holds the batches completed and is
     marked partial. on_checkpoint(result) receives the batches completed so far every
     checkpoint_every_s seconds."""
     if not isinstance(config, SceneConfig):
@@ -107,22 +107,27 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                             config.tallies.local_directions_deg, sc.local_rows,
                             config.nadir_local)
 
-    group = max(1, n_threads)
     done = 0
     t1 = last_checkpoint = time.perf_counter()
     with tqdm(total=n_batches * n_per_batch, unit="photon", unit_scale=True, delay=1.0,
               disable=not progress, desc=config.name[:40], leave=False) as bar, \
-            ThreadPoolExecutor(max_workers=group) as pool:
-        while done < n_batches:
-            hi = min(n_batches, done + group)
-            list(pool.map(run_batch, range(done, hi)))
-            bar.update((hi - done) * n_per_batch)
-            done = hi
-            if should_stop is not None and should_stop():
-                break
-            now = time.perf_counter()
-            if on_checkpoint is not None and done < n_batches \
-                    and now - last_checkpoint >= checkpoint_every_s:
-                on_checkpoint(result_of(done, now - t1))
-                last_checkpoint = now
+            ThreadPoolExecutor(max_workers=n_threads) as pool:
+        # every batch queued at once (no barrier between groups); they finish in about the
+        # order queued and are counted in order, so a stop keeps a prefix of whole batches
+        futures = [pool.submit(run_batch, b) for b in range(n_batches)]
+        try:
+            for future in futures:
+                future.result()
+                done += 1
+                bar.update(n_per_batch)
+                if should_stop is not None and should_stop():
+                    break
+                now = time.perf_counter()
+                if on_checkpoint is not None and done < n_batches \
+                        and now - last_checkpoint >= checkpoint_every_s:
+                    on_checkpoint(result_of(done, now - t1))
+                    last_checkpoint = now
+        finally:
+            for future in futures[done:]:
+                future.cancel()   # the batches in flight finish; the rest never start
     return result_of(done, time.perf_counter() - t1)
