@@ -331,17 +331,19 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     n_sun = n_photons - n_sky
     w_sun = (1.0 - f) * n_photons / n_sun if n_sun > 0 else 0.0
     analog = ctrl.analog
+    # in implicit mode every sun packet enters the same way, so the whole beam of the batch
+    # enters once, as packet -1, before the others, and each sun packet starts below the surface
+    beam_once = not analog and n_sun > 0
     w_sun_in, sx, sy, sz = 0.0, 0.0, 0.0, 1.0
-    if not analog and n_sun > 0:
-        # every implicit-mode sun packet enters the same way: score the beam's entry once
-        launch(p, w_sun * n_sun, sky.sun_sin, 0.0, sky.sun_mu, n_sun > 0)
-        enter_from_air(surface, ctrl, grid, gf, gi, tally, p)
-        w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
     events = 0
     n_stacked = 0   # the split stack is empty between photons
-    for i in range(n_photons):
-        from_sky = i < n_sky
-        if from_sky:
+    for i in range(-1, n_photons):
+        from_sky = 0 <= i < n_sky
+        if i < 0:
+            if not beam_once:
+                continue
+            ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun * n_sun
+        elif from_sky:
             ux, uy, uz, weight = sky_direction(sky, sf)
             w = weight * w_sky
         elif analog:
@@ -349,7 +351,11 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         launch(p, w, ux, uy, uz, not from_sky)
-        if (from_sky or analog) and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
+        if (i < 0 or from_sky or analog) and not enter_from_air(surface, ctrl, grid, gf, gi,
+                                                                tally, p):
+            continue
+        if i < 0:
+            w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
             continue
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, stack, n_stacked, p)
