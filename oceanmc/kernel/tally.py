@@ -11,7 +11,7 @@ tally depths first, then grid.air_level (0+, all light) and grid.air_level + 1 (
 light only)."""
 import math
 
-from .compile import internal, kernel
+from .compile import kernel
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 
 
@@ -99,7 +99,7 @@ def inverse_mu(uz, mu_cut, beam):
     return 1.0 / amu if (amu >= mu_cut or beam) else 2.0 / mu_cut
 
 
-@internal
+@kernel
 def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
     """A crossing of tally level `level` (an in-water depth, or one of the air levels after
     them); beam: the packet is still part of the collimated solar beam."""

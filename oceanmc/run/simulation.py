@@ -16,7 +16,7 @@ from .. import __version__, scene
 from ..config import SceneConfig, config_to_yaml, load_config
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..scene.grid import tally_views
-from .compiling import CompileInterrupted, ready
+from .compiling import ready
 from .results import Result, from_tallies
 
 

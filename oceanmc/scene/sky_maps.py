@@ -71,8 +71,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import config as cfg
-from ..kernel import models
 from .phase_tables import TableError
 
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth

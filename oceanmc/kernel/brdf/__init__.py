@@ -5,9 +5,6 @@ weight = f cos(theta_o) / pdf (the directional-hemispherical reflectance for the
 samplers of Lambertian, Minnaert and the Lambertian + mirror mixture), evaluate(params, wi...,
 wo...) -> f in 1/sr, and pdf(params, wi..., wo...) in 1/sr. Models without an analytic sampler
 (Hapke, measured tables) have only evaluate(); general.py samples them from tables built once
-per scene (brdf_tables.py). dispatch.py picks the module by its integer id; tables.py holds the
-compiled loops that build and check the tables (run once per scene, never per ray).
-
-Importing the package imports dispatch and tables, so that they are compiled into the kernel's
-cache folder (see kernel/__init__.py)."""
-from . import dispatch, tables  # noqa: F401
+per scene (scene/brdf_tables.py). dispatch.py picks the module by its integer id (names and ids:
+oceanmc/registry.py); tables.py holds the compiled loops that build and check the tables (run
+once per scene, never per ray)."""

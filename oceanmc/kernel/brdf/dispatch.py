@@ -19,7 +19,7 @@ def tabulated_sampler(params):
 @kernel
 def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
     """f(wi, wo) in 1/sr; for models with a mirror component only the finite part (local
-    estimates miss the mirror: config.py refuses them for such bottoms)."""
+    estimates miss the mirror: config/scene.py refuses them for such bottoms)."""
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_MINNAERT:

@@ -7,7 +7,7 @@ weight is rho_d + rho_s, exactly f cos / pdf for the branch taken.
 
 evaluate and pdf return only the finite (diffuse) part: a delta function has no value at a
 finite pair of directions. Local (next-event) estimates therefore miss the mirror part, which is
-why config.py refuses local estimates with a bottom that has a mirror component."""
+why config/scene.py refuses local estimates with a bottom that has a mirror component."""
 import math
 
 from ..compile import kernel
