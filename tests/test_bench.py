@@ -13,7 +13,8 @@ def test_quick_bench_writes_report(tmp_path):
             "--configs", str(REPO / "configs")]
     if bare_walk.is_file():
         args += ["--bare-walk", str(bare_walk)]
-    # ~10 loop specialisations to compile on an empty cache, ~70 s each on 2 cores
+    # ~10 loop specialisations to compile on an empty cache, ~70 s each on 2 cores, and one
+    # more for the cold start
     done = subprocess.run(args, capture_output=True, text=True, timeout=1800, cwd=REPO)
     assert done.returncode == 0, done.stderr[-3000:]
     data = json.loads((tmp_path / "b" / "bench.json").read_text())
@@ -39,6 +40,18 @@ def test_quick_bench_writes_report(tmp_path):
     snell = next(c for c in data["error_vs_time"] if c["scene"] == "Snell's window")
     assert snell["reference"] == "analytic"
     assert all(abs(row["z"]) < 5 for row in snell["rows"]), snell["rows"]
+    # --quick: one scene from an empty cache, all four again with a cache, --help, the CLI run
+    rows = data["startup"]["rows"]
+    assert [(r["row"], r["scene"]) for r in rows if r["row"].startswith("cold")] == [
+        ("cold start (empty cache)", "bare_walk.yaml")]
+    assert len([r for r in rows if r["row"] == "cached start"]) == 4
+    assert [r["row"] for r in rows[-2:]] == [
+        "`oceanmc --help`, median of 5",
+        "`oceanmc run default.yaml --photons 20000`, cached, median of 3"]
+    assert all(r["process_s"] > 0 and isinstance(r["pass"], bool) for r in rows)
+    assert all(r["startup_time_s"] >= 0 for r in rows if "start" in r["row"])
     assert (tmp_path / "b" / "error_vs_time.png").stat().st_size > 10_000
     report = (tmp_path / "b" / "bench.md").read_text()
     assert "Speed ceiling" in report and "importance / cosine" in report
+    assert "| cold start (empty cache) | bare_walk.yaml |" in report
+    assert "| kernel <= 1 s |" in report and "| process <= 0.5 s |" in report
