@@ -14,7 +14,7 @@ from typing import Callable
 from ..config import load_config
 from ..run.hdf5 import load_result
 from ..run.simulation import simulate
-from .scenes import FEATURES, QUICK_COLD_START, QUICK_FEATURES, Quantity, with_photons
+from .scenes import FEATURES, QUICK_COLD_START, Quantity, with_photons
 
 # batches per error-vs-time run: the batch standard error, and so the FOM, to about 6% and 12%
 FOM_BATCHES = 128
@@ -57,6 +57,10 @@ def speed_ceiling(configs_dir: Path, bare_walk: Path | None, photons: int, repea
             record[f"bare_{threads}t_runs"] = [r["photons_per_s"] for r in runs]
             record[f"ratio_{threads}t"] = record[f"oceanmc_{threads}t"] / record[f"bare_{threads}t"]
     record["scaling_2t_over_1t"] = record["oceanmc_2t"] / record["oceanmc_1t"]
+    if bare_walk is not None:
+        record["bare_scaling_2t_over_1t"] = record["bare_2t"] / record["bare_1t"]
+        record["scaling_vs_bare"] = record["scaling_2t_over_1t"] \
+            / record["bare_scaling_2t_over_1t"]
     return record
 
 
@@ -66,8 +70,6 @@ def feature_costs(configs_dir: Path, photons: int, repeats: int, quick: bool = F
     config = load_config(configs_dir / "bare_walk.yaml")
     rows = []
     for label, changes in FEATURES:
-        if quick and label not in QUICK_FEATURES:
-            continue
         scene = with_photons(config, photons, **changes)
         speeds = oceanmc_runs(scene, photons, 1, repeats)
         rows.append({"variant": label, "photons_per_s_1t": statistics.median(speeds)})

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .scenes import (COSINE, COSINE_SPLIT, CROSSING_ONLY, IMPORTANCE, NO_ROULETTE, SKY_SPOT,
-                     SPLIT_WEIGHT, SPOT_CONTRAST, SPOT_RADIUS_DEG, SPOT_ZENITH_DEG, UPWARD,
-                     UPWARD_FRACTION)
+from .scenes import (COSINE, COSINE_SPLIT, CROSSING_ONLY, FEATURES_BEFORE, IMPORTANCE, NO_ROULETTE,
+                     SKY_SPOT, SPLIT_WEIGHT, SPOT_CONTRAST, SPOT_RADIUS_DEG, SPOT_ZENITH_DEG,
+                     UPWARD, UPWARD_FRACTION)
 
 
 def fom_summary(curves: list[dict]) -> list[dict]:
@@ -74,11 +74,25 @@ def write_report(out_dir: Path, data: dict) -> None:
         lines.append(f"| {t} | {bare:,.0f} | {s[f'oceanmc_{t}t']:,.0f} | "
                      f"{s[f'ratio_{t}t']:.2f} |" if bare else
                      f"| {t} | (not found) | {s[f'oceanmc_{t}t']:,.0f} | - |")
-    lines += ["", f"Scaling of oceanmc from 1 to 2 threads: {s['scaling_2t_over_1t']:.2f}x.", "",
+    lines += ["", f"Scaling of oceanmc from 1 to 2 threads: {s['scaling_2t_over_1t']:.2f}x"
+              + (f"; of the bare walk in the same run: {s['bare_scaling_2t_over_1t']:.2f}x; "
+                 f"oceanmc's scaling is {s['scaling_vs_bare']:.2f} of the bare walk's."
+                 if "scaling_vs_bare" in s else "."), "",
               "## What each feature costs (bare-walk scene, 1 thread, medians)", "",
-              "| variant | photons/s |", "|---|---|"]
+              "Ratio: photons/s over the bare walk's on 1 thread in this run. Before: the same "
+              "ratio with the kernel before the component records (c077515, its committed "
+              "benchmarks/bench.md).", "",
+              "| variant | photons/s | ratio to the bare walk | before | change |",
+              "|---|---|---|---|---|"]
+    bare_before = FEATURES_BEFORE["bare walk"]
     for row in data["features"]:
-        lines.append(f"| {row['variant']} | {row['photons_per_s_1t']:,.0f} |")
+        ratio = row["photons_per_s_1t"] / s["bare_1t"] if s.get("bare_1t") else None
+        before = FEATURES_BEFORE.get(row["variant"])
+        before = None if before is None else before / bare_before
+        cells = [f"{x:.3f}" if x is not None else "-" for x in (ratio, before)]
+        change = f"{ratio / before - 1.0:+.1%}" if ratio and before else "-"
+        lines.append(f"| {row['variant']} | {row['photons_per_s_1t']:,.0f} | {cells[0]} | "
+                     f"{cells[1]} | {change} |")
     startup = data["startup"]
     lines += ["", "## Start-up", "",
               "Each row a fresh process: `oceanmc run CONFIG --photons "

@@ -194,9 +194,19 @@ FEATURES: list[tuple[str, dict]] = [
     ("analog estimator", {"estimator.mode": "analog"}),
 ]
 
-
-# the --quick smoke test measures only these (each other row compiles a loop of its own)
-QUICK_FEATURES = ("no tallies at all", "+ local nadir-cap estimate")
+# The same rows as measured with the kernel before the component records (c077515's
+# benchmarks/bench.md, full run of 2026-11-21): photons/s on 1 thread, and the bare walk's
+# photons/s on 1 thread in that run. The report sets today's ratios to the bare walk beside
+# those ratios.
+FEATURES_BEFORE = {"bare walk": 5_083_073, "no tallies at all": 4_752_437,
+                   "irradiances at 0, 1 m (radiance off)": 4_734_150,
+                   "+ radiance quads (the bare-walk config)": 4_188_623,
+                   "+ local nadir-cap estimate": 2_981_187,
+                   "+ local estimate, exact nadir": 2_500_212, "+ sky (20% uniform)": 3_808_671,
+                   "+ Lambertian bottom (0.3)": 1_199_230,
+                   f"+ upward-biased scattering (fraction {UPWARD_FRACTION:g}; shorter "
+                   "histories)": 4_106_959,
+                   "no surface (index-matched)": 5_616_350, "analog estimator": 4_631_898}
 
 
 # start-up: the bare-walk scene with every feature the issue names in one loop
