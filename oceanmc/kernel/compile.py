@@ -18,6 +18,10 @@ and bottom events to LLVM's own judgement cost 20% on the bare-walk scene and sa
 time). The crossing scorer, with seven call sites, is a plain `kernel` function: LLVM decides
 (measured: as fast, and 0.8 s less to compile than inlining it everywhere).
 
+`hot`: `kernel` functions that the loop calls at every collision and that tests also call from
+Python, with the alwaysinline attribute (the phase function's sampling and evaluation:
+measured +12% photons/s with an exact-direction local estimate, +6% with the nadir-cap one).
+
 `batch`: the photon loop's entry point (transport.trace_batch), which releases the GIL so that
 batches run in parallel threads. `setup`: functions run once per scene or by tests, which may
 allocate.
@@ -67,5 +71,6 @@ def _jit(**options):
 
 kernel = _jit(_nrt=False, no_cfunc_wrapper=True)
 internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True)
+hot = _jit(_nrt=False, no_cfunc_wrapper=True, forceinline=True)
 batch = _jit(_nrt=False, nogil=True)
 setup = _jit()

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from ..compile import kernel, setup
+from ..compile import hot, kernel, setup
 from ..models import PHASE_HG, PHASE_QUADRATIC, PHASE_TABULATED
 from . import henyey_greenstein, isotropic, quadratic, tabulated
 
@@ -25,7 +25,7 @@ def table_at(medium, mi, k):
             mi[medium.comp_tab_len + k])
 
 
-@kernel
+@hot
 def sample_component(medium, mf, mi, k, u):
     model = mi[medium.comp_model + k]
     if model == PHASE_HG:
@@ -38,7 +38,7 @@ def sample_component(medium, mf, mi, k, u):
     return isotropic.sample(component_params(medium, mf, k), u)
 
 
-@kernel
+@hot
 def evaluate_component(medium, mf, mi, k, cos_psi):
     model = mi[medium.comp_model + k]
     if model == PHASE_HG:
@@ -51,7 +51,7 @@ def evaluate_component(medium, mf, mi, k, cos_psi):
     return isotropic.evaluate(component_params(medium, mf, k), cos_psi)
 
 
-@kernel
+@hot
 def sample_cos(medium, mf, mi, layer, u_pick, u):
     """cos(psi) from the layer's phase function; u_pick chooses the component of a mixture with
     probability b_k / b (it is ignored for a single component, so the caller need not draw it),
@@ -63,7 +63,7 @@ def sample_cos(medium, mf, mi, layer, u_pick, u):
     return sample_component(medium, mf, mi, k, u)
 
 
-@kernel
+@hot
 def evaluate(medium, mf, mi, layer, cos_psi):
     """The layer's phase function p(cos_psi) in 1/sr: the b-weighted sum of its components."""
     first = mi[medium.comp_start + layer]
