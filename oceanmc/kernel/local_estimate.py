@@ -32,6 +32,13 @@ def optical_depth(medium, mf, seg, layer, z):
 
 
 @internal
+def direction(est, ef, k):
+    """The in-water direction (travel, up) of local-estimate row k."""
+    at = est.dirs + 3 * k
+    return ef[at], ef[at + 1], ef[at + 2]
+
+
+@internal
 def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu):
     """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
     t/n^2; 0 if it is not scored there)."""
@@ -77,10 +84,7 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, seg, layer, z, w_
     tau_here = optical_depth(medium, mf, seg, layer, z)
     if est.directions_on:
         for k in range(est.n_dirs):
-            at = est.dirs + 3 * k
-            dx = ef[at]
-            dy = ef[at + 1]
-            dz = ef[at + 2]
+            dx, dy, dz = direction(est, ef, k)
             mu = -dz
             p = phase.evaluate(medium, mf, mi, layer, ux * dx + uy * dy + uz * dz)
             add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, w_scattered * p / mu, mu)
@@ -117,10 +121,7 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, 
     model = bottom.model
     if est.directions_on:
         for k in range(est.n_dirs):
-            at = est.dirs + 3 * k
-            dx = ef[at]
-            dy = ef[at + 1]
-            dz = ef[at + 2]
+            dx, dy, dz = direction(est, ef, k)
             f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
             add_to_levels(est, ef, ei, grid, gf, tally, z, tau_b, k, w * f, -dz)
     if est.cap_on:
