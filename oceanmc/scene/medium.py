@@ -20,8 +20,6 @@ RAYLEIGH_BETA = 1.0
 @dataclass(frozen=True)
 class Column:
     """What the other packers need to know of the water column."""
-    plane_z: np.ndarray        # plane depths: surface first, bottom (or inf) last
-    plane_tau: np.ndarray      # optical depth of each plane
     surface_level: int         # the tally level at 0- (or -1)
     depths: np.ndarray         # tally depths, snapped onto layer boundaries
     level_tau: np.ndarray      # optical depth of each tally depth
@@ -159,5 +157,5 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_start=i.add(comp_start), comp_count=i.add(comp_count),
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
         comp_tab_len=i.add(tab_len))
-    column = Column(plane_z, plane_tau, surface_level, depths, level_tau, albedo)
+    column = Column(surface_level, depths, level_tau, albedo)
     return rec, f.array(), i.array(), column
