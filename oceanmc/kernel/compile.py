@@ -6,7 +6,7 @@ guards its divisions itself; measured +25% photons/s).
 
 `kernel`: every function the photon loop calls. Compiled without Numba's reference counting
 (_nrt=False): each array argument of a call otherwise costs an atomic incref/decref pair at the
-callee (measured: 2.3x fewer photons/s with it). They borrow the caller's arrays, which outlive
+callee (measured on the bare-walk scene: 1.5x fewer photons/s with it). They borrow the caller's arrays, which outlive
 the call, and none of them allocates.
 
 No C-callable (cfunc) wrapper is built for any of them, and none at all for `internal`
@@ -20,7 +20,8 @@ time). The crossing scorer, with seven call sites, is a plain `kernel` function:
 
 `hot`: `kernel` functions that the loop calls at every collision and that tests also call from
 Python, with the alwaysinline attribute (the phase function's sampling and evaluation:
-measured +12% photons/s with an exact-direction local estimate, +6% with the nadir-cap one).
+measured +18% photons/s with an exact-direction local estimate, +14% with the nadir-cap one,
+one run each).
 
 `batch`: the photon loop's entry point (transport.trace_batch), which releases the GIL so that
 batches run in parallel threads. `setup`: functions run once per scene or by tests, which may
