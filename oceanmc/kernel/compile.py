@@ -6,8 +6,8 @@ guards its divisions itself; measured +25% photons/s).
 
 `kernel`: every function the photon loop calls. Compiled without Numba's reference counting
 (_nrt=False): each array argument of a call otherwise costs an atomic incref/decref pair at the
-callee (measured on the bare-walk scene: 1.5x fewer photons/s with it). They borrow the caller's arrays, which outlive
-the call, and none of them allocates.
+callee (measured on the bare-walk scene: 1.5x fewer photons/s with it). They borrow the
+caller's arrays, which outlive the call, and none of them allocates.
 
 No C-callable (cfunc) wrapper is built for any of them, and none at all for `internal`
 functions, which only other compiled functions call (measured: the wrappers were 17% of a cold
