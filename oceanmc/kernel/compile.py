@@ -11,12 +11,12 @@ caller's arrays, which outlive the call, and none of them allocates.
 
 No C-callable (cfunc) wrapper is built for any of them, and none at all for `internal`
 functions, which only other compiled functions call (measured: the wrappers were 17% of a cold
-compilation). `internal` functions carry LLVM's alwaysinline attribute: the events of the photon loop and
-their small helpers, each with one or two call sites, which LLVM merges into their caller
-(1.7x more photons/s than calls that pass a dozen arrays by value; measured: leaving the surface
-and bottom events to LLVM's own judgement cost 20% on the bare-walk scene and saved no compile
-time). The crossing scorer, with seven call sites, is a plain `kernel` function: LLVM decides
-(measured: as fast, and 0.8 s less to compile than inlining it everywhere).
+compilation). `internal` functions carry LLVM's alwaysinline attribute: the events of the photon
+loop and their small helpers, each with one or two call sites, which LLVM merges into their
+caller (1.7x more photons/s than calls that pass a dozen arrays by value; measured: leaving the
+surface and bottom events to LLVM's own judgement cost 20% on the bare-walk scene and saved no
+compile time). The crossing scorer, with seven call sites, is a plain `kernel` function: LLVM
+decides (measured: as fast, and 0.8 s less to compile than inlining it everywhere).
 
 `hot`: `kernel` functions that the loop calls at every collision and that tests also call from
 Python, with the alwaysinline attribute (the phase function's sampling and evaluation:
