@@ -1,4 +1,4 @@
-"""The `oceanmc` command: run scenes, validate the physics, show results files.
+"""The `oceanmc` command: run scenes, validate the physics, show and plot results files.
 
 Exit status: 0 success, 1 a failed validation or a run that could not finish, 2 bad input (a
 config, a path, an option), 130 interrupted.
@@ -207,6 +207,20 @@ def cmd_show(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_plot(args: argparse.Namespace) -> int:
+    from .plot.results import PlotInputError, plot_result
+
+    try:
+        written = plot_result(args.file, args.output, depth=args.depth, wavelength=args.wavelength)
+    except PlotInputError as exc:
+        raise UsageError(str(exc)) from None
+    except OSError as exc:
+        raise UsageError(f"-o {args.output}: cannot write the figures there ({exc})") from None
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
     from . import validation
 
@@ -286,6 +300,19 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("file", metavar="RESULT.h5")
     show.add_argument("--config", action="store_true", help="also print the stored scene")
     show.set_defaults(func=cmd_show)
+
+    plot = sub.add_parser("plot", help="draw a results file's Rrs spectrum, irradiance profiles "
+                                       "and radiance distribution to PNG")
+    plot.add_argument("file", metavar="RESULT.h5")
+    plot.add_argument("-o", "--output", metavar="DIR|PREFIX",
+                      help="folder, or file prefix for _rrs.png, _profiles.png, _radiance.png "
+                           "(default: RESULT without .h5)")
+    plot.add_argument("--depth", type=float, metavar="Z",
+                      help="tallied depth (m) of the radiance plot (default: 0, just below)")
+    plot.add_argument("--wavelength", type=float, metavar="NM",
+                      help="draw this wavelength only (default: a few across the spectrum; "
+                           "the middle one for the radiance)")
+    plot.set_defaults(func=cmd_plot)
     return parser
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plot import panels, save
 from .scenes import (COSINE, COSINE_SPLIT, CROSSING_ONLY, FEATURES_BEFORE, IMPORTANCE, NO_ROULETTE,
                      SKY_SPOT, SPLIT_WEIGHT, SPOT_CONTRAST, SPOT_RADIUS_DEG, SPOT_ZENITH_DEG,
                      UPWARD, UPWARD_FRACTION)
@@ -26,15 +27,8 @@ def fom_summary(curves: list[dict]) -> list[dict]:
 
 
 def plot(curves: list[dict], path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    ncols = min(3, len(curves))
-    nrows = -(-len(curves) // ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 4 * nrows), squeeze=False)
-    for ax in axes.flat[len(curves):]:
-        ax.set_visible(False)
-    for ax, curve in zip(axes.flat, curves):
+    fig, axes = panels(len(curves), 3, (4.6, 4.0))
+    for ax, curve in zip(axes, curves):
         labels = sorted({r["quantity"] for r in curve["rows"]})
         for label in labels:
             rows = [r for r in curve["rows"] if r["quantity"] == label]
@@ -51,9 +45,7 @@ def plot(curves: list[dict], path: Path) -> None:
         ax.legend(fontsize=6)
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle("error against run time; dotted: 1/sqrt(t)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
 
 
 def write_report(out_dir: Path, data: dict) -> None:

@@ -92,8 +92,6 @@ def main(out_dir: Path = Path("validation"), quick: bool = False, *,
          cases: list[str] | None = None, override: dict | None = None,
          threads: int | None = None) -> int:
     """Runs the validation cases and writes the report; returns 0 if every check passed, else 1."""
-    import matplotlib
-    matplotlib.use("Agg")
     from .report import write_report, write_results
 
     out_dir = Path(out_dir)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plot import close, save
 from .stats import JK, MIN_Z_TOL, chi2_z, hotelling_z, z_score, z_tolerance
 
 
@@ -212,14 +213,11 @@ class Ctx:
 
     def figure(self, fig, name: str, caption: str) -> None:
         if self.fig_dir is None:
-            import matplotlib.pyplot as plt
-            plt.close(fig)
+            close(fig)
             return
         self.fig_dir.mkdir(parents=True, exist_ok=True)
         file = f"{self.case}_{name}.png"
-        fig.savefig(self.fig_dir / file, dpi=110, bbox_inches="tight")
-        import matplotlib.pyplot as plt
-        plt.close(fig)
+        save(fig, self.fig_dir / file, crop=True)
         self.figures.append((file, caption))
 
     def note(self, text: str) -> None:

@@ -9,6 +9,7 @@ from typing import Callable
 
 import numpy as np
 
+from ...plot import pyplot as _plt  # noqa: F401 (the cases draw their figures through it)
 from .. import references as ref
 from ..context import Ctx
 from ..stats import JK
@@ -127,13 +128,6 @@ def compare_symmetric_radiance(ctx: Ctx, r, rad: JK, edges: np.ndarray, bands, f
     ctx.compare_jk(quad_check, q, qref, labels=labels, rel_cap=ctx.pick(*quad_cap),
                    counts=expected_counts(qref, ti, edges, per_batch, len(r.coords["phi"])))
     return band_ref
-
-
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 # --- DISORT slabs (the disort and upward_bias cases) --------------------------------------------

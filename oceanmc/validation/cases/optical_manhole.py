@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from .. import references as ref
+from ...plot import log_norm, polar_quads
 from ..context import Ctx
 from ..stats import JK
 from .common import (N_WATER, Case, _plt, band_labels, band_refs, clear_layer,
@@ -138,7 +139,6 @@ def case_manhole(ctx: Ctx) -> None:
 
     # figures
     plt = _plt()
-    from matplotlib.colors import LogNorm
     fig, axes = plt.subplots(1, 2, subplot_kw={"projection": "polar"}, figsize=(10, 4.6))
     for ax, (title, (rr, ee, rd)) in zip(axes, (
             ("uniform sky, clear water, black bottom", (sky_runs["uniform"][0],
@@ -147,17 +147,13 @@ def case_manhole(ctx: Ctx) -> None:
                                                               "radiance")[0])),
             ("sun at zenith, Lambertian bottom (rho = 1)", tir_run))):
         dn = hemisphere_bands(ee, up=False)
-        phi_e = np.radians(np.asarray(rr.coords["phi_edges"]))
         t_e = np.append(ee[dn], ee[dn[-1] + 1])
         vals = rd.value[dn, :].copy()
-        vals = np.where(vals > 0, vals, np.nan)
-        finite = vals[np.isfinite(vals)]
-        norm = LogNorm(vmin=max(finite.min(), finite.max() * 1e-3), vmax=finite.max())
+        norm = log_norm(vals)
         if ee[dn[0] + 1] <= 5.0 and "sun" in title:
             vals[0, :] = np.nan    # the transmitted sun's cap: off the scale
-            finite = vals[np.isfinite(vals)]
-            norm = LogNorm(vmin=finite.min(), vmax=finite.max())
-        mesh = ax.pcolormesh(phi_e, t_e, vals, norm=norm, cmap="viridis", shading="flat")
+            norm = log_norm(vals, dynamic_range=np.inf)
+        mesh = polar_quads(ax, t_e, rr.coords["phi_edges"], vals, norm)
         tt = np.linspace(0, 2 * np.pi, 361)
         ax.plot(tt, np.full_like(tt, theta_c), "w--", lw=1.2)
         ax.set_ylim(0, 90)

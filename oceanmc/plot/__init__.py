@@ -1,0 +1,68 @@
+"""Figures drawn off screen: the one place where oceanmc sets up matplotlib and draws the pieces
+its figures share. Used by `oceanmc plot` (results.py), the validation report's cases and the
+benchmark report."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+DPI = 110
+
+
+def pyplot():
+    """matplotlib.pyplot on the Agg backend: PNG files, no screen needed."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def panels(n: int, ncols: int, panel_size: tuple[float, float], **subplot_kw):
+    """A figure with n panels on a grid of at most ncols columns, each panel_size (inches);
+    subplot_kw as for matplotlib (e.g. projection="polar"). Returns (figure, list of n axes);
+    the grid's unused cells are removed. The layout is matplotlib's constrained one, so that the
+    PNG has the figure's size (panel_size times the grid, at DPI) and nothing overlaps."""
+    plt = pyplot()
+    ncols = min(ncols, n)
+    nrows = -(-n // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(panel_size[0] * ncols, panel_size[1] * nrows),
+                             squeeze=False, subplot_kw=subplot_kw or None, layout="constrained")
+    for ax in axes.flat[n:]:
+        fig.delaxes(ax)
+    return fig, list(axes.flat[:n])
+
+
+def save(fig, path: str | Path, crop: bool = False) -> Path:
+    """Writes the figure as PNG and frees it; crop: to the drawn area (the PNG's size then
+    depends on the contents), else at the figure's size."""
+    path = Path(path)
+    fig.savefig(path, dpi=DPI, bbox_inches="tight" if crop else None)
+    close(fig)
+    return path
+
+
+def close(fig) -> None:
+    pyplot().close(fig)
+
+
+def log_norm(values: np.ndarray, dynamic_range: float = 1e3):
+    """A logarithmic colour scale over the positive, finite values, spanning at most
+    dynamic_range below the largest (so that one bright quad, e.g. the sun's, does not wash out
+    the rest); None where no value is positive."""
+    from matplotlib.colors import LogNorm
+    values = np.asarray(values, dtype=np.float64)
+    positive = values[np.isfinite(values) & (values > 0)]
+    if positive.size == 0:
+        return None
+    top = float(positive.max())
+    return LogNorm(vmin=max(float(positive.min()), top / dynamic_range), vmax=top)
+
+
+def polar_quads(ax, theta_edges_deg, phi_edges_deg, values, norm, cmap: str = "viridis"):
+    """Quad values (rows: polar-angle bands, columns: azimuth bands) as annular sectors of a
+    polar axes: azimuth phi, radius the polar angle (deg) of theta_edges_deg. Non-positive
+    values are left blank on a logarithmic scale."""
+    values = np.where(np.asarray(values) > 0, values, np.nan)
+    return ax.pcolormesh(np.radians(np.asarray(phi_edges_deg)), np.asarray(theta_edges_deg),
+                         values, norm=norm, cmap=cmap, shading="flat")

@@ -1,0 +1,265 @@
+"""`oceanmc plot RESULT.h5`: the figures of a results file, as PNG.
+
+- the remote-sensing reflectance Rrs (air/Rrs_nadir) against wavelength with its standard-error
+  band (one marker for a monochromatic file);
+- Ed, Eu and Eo against depth, one line per selected wavelength, log irradiance axis, error bars
+  of one standard error;
+- the radiance distribution at one depth and at 0+ (group air) on the polar quads, the downwelling
+  and the upwelling hemispheres side by side.
+
+Files are read with xarray. A spectral file has a coordinate `wavelength` (nm) as the leading
+dimension of every spectral quantity; a monochromatic file has none, and both are drawn.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import log_norm, panels, polar_quads, pyplot, save
+
+# at most this many wavelengths share a profile panel (evenly spaced over the file's grid), so
+# that the lines stay distinguishable
+MAX_PROFILE_WAVELENGTHS = 6
+
+
+class PlotInputError(ValueError):
+    """A results file or an option the figures cannot be drawn from; the message says why."""
+
+
+@dataclass
+class ResultFile:
+    water: object          # xarray.Dataset of the root group (in water)
+    air: object            # xarray.Dataset of the group air (0+)
+    path: Path
+
+    @property
+    def wavelengths(self) -> np.ndarray | None:
+        """The wavelengths (nm) of a spectral file; None for a monochromatic one."""
+        if "wavelength" not in self.water.coords:
+            return None
+        return np.asarray(self.water.coords["wavelength"], dtype=np.float64)
+
+    @property
+    def depths(self) -> np.ndarray:
+        return np.asarray(self.water.coords["depth"], dtype=np.float64)
+
+
+def open_result(path: str | Path) -> ResultFile:
+    import xarray as xr
+    path = Path(path)
+    if not path.is_file():
+        raise PlotInputError(f"{path}: no such file")
+    try:
+        water = xr.load_dataset(path, engine="h5netcdf")
+    except (OSError, ValueError) as exc:
+        raise PlotInputError(f"{path}: not an oceanmc results file (not readable as HDF5: "
+                             f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
+                             ) from None
+    if "format_version" not in water.attrs or "Ed" not in water:
+        raise PlotInputError(f"{path}: not an oceanmc results file (no format_version attribute "
+                             "or no Ed)")
+    try:
+        air = xr.load_dataset(path, engine="h5netcdf", group="air")
+    except (OSError, ValueError):
+        raise PlotInputError(f"{path}: not an oceanmc results file (no group air)") from None
+    return ResultFile(water, air, path)
+
+
+def _listed(values: np.ndarray) -> str:
+    return ", ".join(f"{v:g}" for v in values)
+
+
+def depth_index(result: ResultFile, depth: float | None) -> int:
+    """The index of --depth in the file's tallied depths; the first (0 = 0-) by default."""
+    if depth is None:
+        return 0
+    hits = np.nonzero(np.isclose(result.depths, depth, rtol=0.0, atol=1e-9))[0]
+    if hits.size == 0:
+        raise PlotInputError(f"--depth {depth:g}: not a tallied depth of {result.path.name}; "
+                             f"allowed: {_listed(result.depths)} (m)")
+    return int(hits[0])
+
+
+def wavelength_indices(result: ResultFile, wavelength: float | None) -> list[int]:
+    """The wavelengths to draw: --wavelength alone, else up to MAX_PROFILE_WAVELENGTHS evenly
+    spaced over the file's grid; [] for a monochromatic file."""
+    grid = result.wavelengths
+    if grid is None:
+        if wavelength is not None:
+            raise PlotInputError(f"--wavelength {wavelength:g}: {result.path.name} is "
+                                 "monochromatic (it has no wavelength dimension); leave it out")
+        return []
+    if wavelength is not None:
+        hits = np.nonzero(np.isclose(grid, wavelength, rtol=0.0, atol=1e-6))[0]
+        if hits.size == 0:
+            raise PlotInputError(f"--wavelength {wavelength:g}: not a wavelength of "
+                                 f"{result.path.name}; allowed: {_listed(grid)} (nm)")
+        return [int(hits[0])]
+    count = min(len(grid), MAX_PROFILE_WAVELENGTHS)
+    return [int(i) for i in np.unique(np.round(np.linspace(0, len(grid) - 1, count)))]
+
+
+def _at(array, index: int | None):
+    """The values of one wavelength of a spectral quantity (index None: monochromatic)."""
+    return array if index is None else array.isel(wavelength=index)
+
+
+def _wavelength_colours(result: ResultFile, indices: list[int]) -> dict:
+    plt = pyplot()
+    grid = result.wavelengths
+    if grid is None:
+        return {None: "k"}
+    span = max(float(grid[-1] - grid[0]), 1e-9)
+    cmap = plt.get_cmap("turbo")
+    return {i: cmap(0.05 + 0.9 * (grid[i] - grid[0]) / span) for i in indices}
+
+
+def _wavelength_label(result: ResultFile, index: int | None) -> str:
+    return "" if index is None else f"{result.wavelengths[index]:g} nm"
+
+
+# --- the figures -------------------------------------------------------------------------------
+
+def rrs_figure(result: ResultFile):
+    """air/Rrs_nadir against wavelength, shaded +- one standard error; one marker with its error
+    bar for a monochromatic file. None where the file has no Rrs_nadir."""
+    if "Rrs_nadir" not in result.air:
+        return None
+    rrs = result.air["Rrs_nadir"]
+    err = result.air["Rrs_nadir_stderr"]
+    grid = result.wavelengths
+    value, se = np.atleast_1d(np.asarray(rrs)), np.atleast_1d(np.asarray(err))
+    fig, (ax,) = panels(1, 1, (6.0, 4.0) if grid is not None else (3.5, 4.0))
+    if grid is None:
+        ax.errorbar([0.0], value, yerr=se, fmt="o", color="k", capsize=4,
+                    label=f"Rrs nadir = {value[0]:.4g} +- {se[0]:.2g}\n(monochromatic run)")
+        ax.set_xticks([])
+        ax.set_xlim(-1.0, 1.0)
+    else:
+        ax.fill_between(grid, value - se, value + se, color="C0", alpha=0.3,
+                        label="+- 1 standard error")
+        ax.plot(grid, value, "o-", color="C0", ms=3, label="Rrs nadir")
+        ax.set_xlabel("wavelength (nm)")
+    top = np.nanmax(value + np.nan_to_num(se))
+    ax.set_ylim(0.0, 1.3 * top if top > 0 else 1.0)
+    ax.set_ylabel(f"Rrs ({rrs.attrs.get('units', 'sr-1')})")
+    ax.set_title(f"remote-sensing reflectance: {result.water.attrs.get('name', result.path.name)}",
+                 fontsize=9)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward plane irradiance Eu"),
+                      ("Eo", "scalar irradiance Eo"))
+
+
+def profiles_figure(result: ResultFile, indices: list[int]):
+    """Ed, Eu and Eo against depth (one panel each), one line per wavelength index (indices []:
+    monochromatic), irradiance on a log axis, error bars of one standard error."""
+    fig, axes = panels(len(PROFILE_QUANTITIES), 3, (4.2, 4.6))
+    lines = indices or [None]
+    colours = _wavelength_colours(result, lines)
+    for ax, (name, title) in zip(axes, PROFILE_QUANTITIES):
+        for index in lines:
+            value = np.asarray(_at(result.water[name], index))
+            err = np.asarray(_at(result.water[name + "_stderr"], index))
+            shown = value > 0   # a log axis: a zero (e.g. Eu over a black bottom) is left out
+            ax.errorbar(value[shown], result.depths[shown], xerr=err[shown], fmt="o-", ms=3,
+                        capsize=2, color=colours[index],
+                        label=_wavelength_label(result, index) or None)
+        _log_x(ax, np.asarray(result.water[name]))
+        ax.invert_yaxis()
+        ax.set_xlabel(f"{name} ({result.water[name].attrs.get('units', '')})", fontsize=8)
+        ax.set_title(title, fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("depth (m; 0 is 0-, just below the surface)")
+    if indices:
+        axes[0].legend(fontsize=7, title="wavelength", title_fontsize=7)
+    return fig
+
+
+def _log_x(ax, values: np.ndarray) -> None:
+    """A logarithmic x axis whose tick labels stay readable: over less than a decade the default
+    labels every minor tick (they overlap), so a few plain ticks are placed instead."""
+    from matplotlib.ticker import MaxNLocator, NullFormatter, ScalarFormatter
+    ax.set_xscale("log")
+    positive = values[np.isfinite(values) & (values > 0)]
+    if positive.size and positive.max() < 10.0 * positive.min():
+        ax.xaxis.set_major_locator(MaxNLocator(4))
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def _hemispheres(theta_edges: np.ndarray, values: np.ndarray):
+    """(title, radius edges, rows) of the downwelling (travel theta < 90) and the upwelling
+    hemisphere; the radius is the angle from the pole one looks at: theta for downwelling light
+    (0 = light from the zenith), 180 - theta for upwelling light (0 = light from the nadir)."""
+    split = int(np.nonzero(np.isclose(theta_edges, 90.0))[0][0])
+    down = (theta_edges[:split + 1], values[:split])
+    up = (180.0 - theta_edges[split:][::-1], values[split:][::-1])
+    return (("downwelling (radius: zenith angle looked at)",) + down,
+            ("upwelling (radius: nadir angle looked at)",) + up)
+
+
+def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
+    """The radiance on the polar quads at one tallied depth (top row) and at 0+ (bottom row),
+    downwelling and upwelling hemispheres side by side, each on its own logarithmic colour scale.
+    None where the file has no radiance."""
+    if "radiance" not in result.water:
+        return None
+    theta_edges = np.asarray(result.water.coords["theta_edges"], dtype=np.float64)
+    phi_edges = np.asarray(result.water.coords["phi_edges"], dtype=np.float64)
+    rows = [(f"{result.depths[depth]:g} m" + (" (0-)" if result.depths[depth] == 0 else ""),
+             _at(result.water["radiance"], wavelength).isel(depth=depth))]
+    if "radiance" in result.air:
+        rows.append(("0+ (in air)", _at(result.air["radiance"], wavelength)))
+    fig, axes = panels(2 * len(rows), 2, (4.6, 4.2), projection="polar")
+    for r, (where, radiance) in enumerate(rows):
+        for c, (title, radius_edges, values) in enumerate(
+                _hemispheres(theta_edges, np.asarray(radiance))):
+            ax = axes[2 * r + c]
+            norm = log_norm(values)
+            if norm is not None:
+                mesh = polar_quads(ax, radius_edges, phi_edges, values, norm)
+                fig.colorbar(mesh, ax=ax, shrink=0.75, pad=0.1,
+                             label=radiance.attrs.get("units", ""))
+            ax.set_ylim(0.0, 90.0)
+            ax.set_yticks([30, 60, 90])
+            ax.tick_params(labelsize=7)
+            ax.set_title(f"{where}, {title}" + ("" if norm is not None else ": no light"),
+                         fontsize=8)
+    label = _wavelength_label(result, wavelength)
+    fig.suptitle("radiance on the quads (azimuth: phi of travel from the sun's travel azimuth)"
+                 + (f", {label}" if label else ""), fontsize=9)
+    return fig
+
+
+def plot_result(path: str | Path, out: str | Path | None = None, depth: float | None = None,
+                wavelength: float | None = None) -> list[Path]:
+    """Writes the figures of a results file as PNG and returns their paths. out: a folder
+    (existing, or ending in '/'), the files then named after the results file, or a prefix to
+    which _rrs.png, _profiles.png, _radiance.png are appended; by default the results file's
+    path without .h5."""
+    result = open_result(path)
+    at_depth = depth_index(result, depth)
+    indices = wavelength_indices(result, wavelength)
+    prefix = _prefix(result.path, out)
+    radiance_wavelength = None
+    if result.wavelengths is not None:
+        radiance_wavelength = indices[0] if wavelength is not None else len(result.wavelengths) // 2
+    figures = {"rrs": rrs_figure(result), "profiles": profiles_figure(result, indices),
+               "radiance": radiance_figure(result, at_depth, radiance_wavelength)}
+    prefix.parent.mkdir(parents=True, exist_ok=True)
+    return [save(fig, f"{prefix}_{name}.png") for name, fig in figures.items() if fig is not None]
+
+
+def _prefix(path: Path, out: str | Path | None) -> Path:
+    if out is None:
+        return path.with_suffix("")
+    text = str(out)
+    if text.endswith(("/", "\\")) or Path(text).is_dir():
+        return Path(text) / path.stem
+    return Path(text)
