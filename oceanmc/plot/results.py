@@ -52,7 +52,7 @@ def open_result(path: str | Path) -> ResultFile:
     if not path.is_file():
         raise PlotInputError(f"{path}: no such file")
     try:
-        water = xr.load_dataset(path, engine="h5netcdf")
+        water = xr.load_dataset(path, engine="h5netcdf", phony_dims="access")
     except (OSError, ValueError) as exc:
         raise PlotInputError(f"{path}: not an oceanmc results file (not readable as HDF5: "
                              f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
@@ -172,7 +172,8 @@ def profiles_figure(result: ResultFile, indices: list[int]):
                         label=_wavelength_label(result, index) or None)
         _log_x(ax, np.asarray(result.water[name]))
         ax.invert_yaxis()
-        ax.set_xlabel(f"{name} ({result.water[name].attrs.get('units', '')})", fontsize=8)
+        units = result.water[name].attrs.get("units")
+        ax.set_xlabel(f"{name} ({units})" if units else name, fontsize=8)
         ax.set_title(title, fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("depth (m; 0 is 0-, just below the surface)")

@@ -1,0 +1,220 @@
+"""`oceanmc plot`: the figures of a real monochromatic run and of a synthetic spectral file (the
+layout of spectral results: a leading `wavelength` dimension), the PNGs the command writes and
+its one-line errors."""
+import os
+import struct
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+import xarray as xr
+
+from conftest import REPO, SMALL_SCENE
+from oceanmc.cli import main
+from oceanmc.config.tallies import HYDROLIGHT_THETA_EDGES_DEG
+from oceanmc.plot import DPI, close
+from oceanmc.plot.results import (MAX_PROFILE_WAVELENGTHS, open_result, profiles_figure,
+                                  radiance_figure, rrs_figure, wavelength_indices)
+
+WAVELENGTHS = np.arange(400.0, 701.0, 10.0)
+SPECTRAL_DEPTHS = np.array([0.0, 2.0, 5.0])
+
+
+@pytest.fixture(scope="module")
+def mono_file(tmp_path_factory):
+    """A real (small) monochromatic run."""
+    import oceanmc
+    result = oceanmc.simulate(oceanmc.load_config(SMALL_SCENE), threads=1)
+    return result.save(tmp_path_factory.mktemp("mono") / "mono.h5")
+
+
+@pytest.fixture(scope="module")
+def spectral_file(tmp_path_factory):
+    """A synthetic spectral results file: every spectral quantity with a leading wavelength
+    dimension, values chosen so that each wavelength and depth is told apart."""
+    theta_edges = np.array(HYDROLIGHT_THETA_EDGES_DEG)
+    phi_edges = np.arange(-7.5, 360.0, 15.0)
+    theta = 0.5 * (theta_edges[1:] + theta_edges[:-1])
+    phi = 0.5 * (phi_edges[1:] + phi_edges[:-1])
+    k = 0.02 + 1e-4 * (WAVELENGTHS - 400.0)                # attenuation per wavelength (1/m)
+    ed = np.exp(-np.outer(k, SPECTRAL_DEPTHS))             # (wavelength, depth)
+    shape = (len(WAVELENGTHS), len(SPECTRAL_DEPTHS), len(theta), len(phi))
+    radiance = 1.0 + np.arange(np.prod(shape), dtype=np.float64).reshape(shape)
+    spectral = {"wavelength": WAVELENGTHS}
+    water = xr.Dataset(
+        {name: (("wavelength", "depth"), scale * ed) for name, scale in
+         (("Ed", 1.0), ("Ed_stderr", 0.01), ("Eu", 0.05), ("Eu_stderr", 0.001),
+          ("Eo", 1.3), ("Eo_stderr", 0.02))}
+        | {"radiance": (("wavelength", "depth", "theta", "phi"), radiance),
+           "radiance_stderr": (("wavelength", "depth", "theta", "phi"), 0.01 * radiance)},
+        coords=spectral | {"depth": SPECTRAL_DEPTHS, "theta": theta, "phi": phi,
+                           "theta_edges": theta_edges, "phi_edges": phi_edges},
+        attrs={"format_version": 1, "name": "synthetic spectrum"})
+    rrs = 0.005 * np.exp(-((WAVELENGTHS - 490.0) / 80.0) ** 2)
+    air = xr.Dataset({"Rrs_nadir": ("wavelength", rrs), "Rrs_nadir_stderr": ("wavelength",
+                                                                             0.05 * rrs),
+                      "radiance": (("wavelength", "theta", "phi"), 2.0 * radiance[:, 0])},
+                     coords=spectral | {"theta": theta, "phi": phi})
+    path = tmp_path_factory.mktemp("spectral") / "spectral.h5"
+    water.to_netcdf(path, engine="h5netcdf")
+    air.to_netcdf(path, engine="h5netcdf", group="air", mode="a")
+    return path
+
+
+def png_size(path):
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", head[16:24])
+
+
+def polar_axes(fig):
+    return [ax for ax in fig.axes if ax.name == "polar"]
+
+
+# --- the figures --------------------------------------------------------------------------------
+
+def test_rrs_spectrum_line_and_standard_error_band(spectral_file):
+    result = open_result(spectral_file)
+    fig = rrs_figure(result)
+    (ax,) = fig.axes
+    (line,) = ax.get_lines()
+    np.testing.assert_array_equal(line.get_xdata(), WAVELENGTHS)
+    np.testing.assert_allclose(line.get_ydata(), result.air["Rrs_nadir"])
+    (band,) = ax.collections                               # fill_between: value +- stderr
+    lower = band.get_paths()[0].vertices[:, 1].min()
+    assert lower == pytest.approx(float((result.air["Rrs_nadir"]
+                                         - result.air["Rrs_nadir_stderr"]).min()))
+    close(fig)
+
+
+def test_rrs_monochromatic_is_one_marker(mono_file):
+    result = open_result(mono_file)
+    fig = rrs_figure(result)
+    (ax,) = fig.axes
+    (bars,) = ax.containers
+    marker = bars.lines[0]
+    assert marker.get_ydata()[0] == pytest.approx(float(result.air["Rrs_nadir"]))
+    assert len(marker.get_xdata()) == 1
+    close(fig)
+
+
+def test_profiles_spectral_lines_per_wavelength(spectral_file):
+    result = open_result(spectral_file)
+    indices = wavelength_indices(result, None)
+    assert len(indices) == MAX_PROFILE_WAVELENGTHS
+    assert WAVELENGTHS[indices[0]] == 400.0 and WAVELENGTHS[indices[-1]] == 700.0
+    fig = profiles_figure(result, indices)
+    assert [ax.get_title() for ax in fig.axes] == ["downward plane irradiance Ed",
+                                                   "upward plane irradiance Eu",
+                                                   "scalar irradiance Eo"]
+    for ax, name in zip(fig.axes, ("Ed", "Eu", "Eo")):
+        assert ax.get_xscale() == "log" and ax.yaxis_inverted()
+        assert len(ax.containers) == MAX_PROFILE_WAVELENGTHS
+        for bars, i in zip(ax.containers, indices):
+            np.testing.assert_allclose(bars.lines[0].get_xdata(), result.water[name][i])
+            np.testing.assert_array_equal(bars.lines[0].get_ydata(), SPECTRAL_DEPTHS)
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert legend == [f"{WAVELENGTHS[i]:g} nm" for i in indices]
+    close(fig)
+    fig = profiles_figure(result, wavelength_indices(result, 550.0))
+    assert [len(ax.containers) for ax in fig.axes] == [1, 1, 1]
+    close(fig)
+
+
+def test_profiles_monochromatic(mono_file):
+    result = open_result(mono_file)
+    fig = profiles_figure(result, wavelength_indices(result, None))
+    assert len(fig.axes) == 3
+    for ax, name in zip(fig.axes, ("Ed", "Eu", "Eo")):
+        (bars,) = ax.containers
+        np.testing.assert_allclose(bars.lines[0].get_xdata(), result.water[name])
+        np.testing.assert_array_equal(bars.lines[0].get_ydata(), SMALL_SCENE["tallies"]
+                                      ["depths_m"])
+    close(fig)
+
+
+def test_radiance_hemispheres_at_depth_and_in_air(spectral_file):
+    result = open_result(spectral_file)
+    fig = radiance_figure(result, depth=1, wavelength=3)
+    axes = polar_axes(fig)
+    assert len(axes) == 4                                  # (depth, 0+) x (down, up)
+    meshes = [ax.collections[0].get_array().reshape(10, 24) for ax in axes]
+    at_depth = result.water["radiance"].values[3, 1]       # (theta, phi), 20 bands
+    np.testing.assert_array_equal(meshes[0], at_depth[:10])
+    np.testing.assert_array_equal(meshes[1], at_depth[10:][::-1])   # nadir at the centre
+    in_air = result.air["radiance"].values[3]
+    np.testing.assert_array_equal(meshes[2], in_air[:10])
+    np.testing.assert_array_equal(meshes[3], in_air[10:][::-1])
+    assert "430 nm" in fig.get_suptitle() and "2 m" in axes[0].get_title()
+    close(fig)
+
+
+def test_radiance_monochromatic_real_run(mono_file):
+    result = open_result(mono_file)
+    fig = radiance_figure(result, depth=0, wavelength=None)
+    axes = polar_axes(fig)
+    assert len(axes) == 4
+    radiance = result.water["radiance"].values[0]
+    mesh = axes[0].collections[0].get_array().reshape(10, -1)
+    np.testing.assert_array_equal(mesh.filled(np.nan), np.where(radiance[:10] > 0,
+                                                                radiance[:10], np.nan))
+    close(fig)
+
+
+# --- the command --------------------------------------------------------------------------------
+
+EXPECTED_INCHES = {"rrs": (3.5, 4.0), "profiles": (12.6, 4.6), "radiance": (9.2, 8.4)}
+
+
+def test_command_writes_pngs_of_the_figure_size(mono_file, tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "plot", str(mono_file), "-o",
+                           str(tmp_path / "figs") + "/"], env=env, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    for name, (width, height) in EXPECTED_INCHES.items():
+        png = tmp_path / "figs" / f"mono_{name}.png"
+        assert f"wrote {png}" in done.stdout
+        assert png.stat().st_size > 10_000
+        w, h = png_size(png)
+        assert abs(w - width * DPI) <= 1 and abs(h - height * DPI) <= 1, (name, w, h)
+
+
+def test_command_spectral_with_prefix_and_options(spectral_file, tmp_path, capsys):
+    prefix = tmp_path / "sub" / "fig"
+    assert main(["plot", str(spectral_file), "-o", str(prefix), "--depth", "5",
+                 "--wavelength", "550"]) == 0
+    written = sorted(tmp_path.joinpath("sub").glob("*.png"))
+    assert [p.name for p in written] == ["fig_profiles.png", "fig_radiance.png", "fig_rrs.png"]
+    w, h = png_size(tmp_path / "sub" / "fig_rrs.png")
+    assert abs(w - 6.0 * DPI) <= 1 and abs(h - 4.0 * DPI) <= 1
+    assert all(p.stat().st_size > 10_000 for p in written)
+
+
+def one_line_error(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("oceanmc: error: "), err
+    return err
+
+
+def test_errors_name_the_problem(mono_file, spectral_file, tmp_path, capsys):
+    err = one_line_error(capsys, ["plot", str(tmp_path / "none.h5")])
+    assert "none.h5: no such file" in err
+    text = tmp_path / "notes.h5"
+    text.write_text("not hdf5")
+    assert "not an oceanmc results file" in one_line_error(capsys, ["plot", str(text)])
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f["x"] = np.arange(3)
+    assert "not an oceanmc results file" in one_line_error(capsys, ["plot", str(other)])
+    err = one_line_error(capsys, ["plot", str(mono_file), "--depth", "3"])
+    assert "--depth 3: not a tallied depth" in err and "allowed: 0, 1, 2 (m)" in err
+    err = one_line_error(capsys, ["plot", str(mono_file), "--wavelength", "550"])
+    assert "--wavelength 550" in err and "monochromatic" in err
+    err = one_line_error(capsys, ["plot", str(spectral_file), "--wavelength", "555"])
+    assert "--wavelength 555: not a wavelength" in err and "allowed: 400, 410," in err
+    assert not list(tmp_path.glob("*.png"))
