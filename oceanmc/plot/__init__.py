@@ -66,3 +66,14 @@ def polar_quads(ax, theta_edges_deg, phi_edges_deg, values, norm, cmap: str = "v
     values = np.where(np.asarray(values) > 0, values, np.nan)
     return ax.pcolormesh(np.radians(np.asarray(phi_edges_deg)), np.asarray(theta_edges_deg),
                          values, norm=norm, cmap=cmap, shading="flat")
+
+
+def half_polar(ax, title: str) -> None:
+    """A polar axes as the upper half-plane of a plane of incidence: angle 0 up (the normal),
+    positive clockwise, -90 to 90 deg."""
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    ax.tick_params(labelsize=7)
+    ax.set_title(title, fontsize=9)

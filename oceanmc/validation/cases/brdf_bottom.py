@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ...plot import half_polar
 from .. import references as ref
 from ..context import Ctx
 from ..stats import JK
@@ -70,13 +71,8 @@ def case_brdf(ctx: Ctx) -> None:
         t = np.linspace(-89.9, 89.9, 400)
         ax.plot(np.radians(t), ref.minnaert_radiance(rho, k, mu_i, np.cos(np.radians(t))), "k-",
                 lw=1, label="analytic")
-        ax.set_theta_zero_location("N")
-        ax.set_theta_direction(-1)
-        ax.set_thetamin(-90)
-        ax.set_thetamax(90)
         ax.yaxis.set_major_locator(MaxNLocator(3))
-        ax.tick_params(labelsize=7)
-        ax.set_title(f"{label_m}, theta_i = 30 deg", fontsize=9)
+        half_polar(ax, f"{label_m}, theta_i = 30 deg")
     axes[0].legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.25))
     ctx.figure(fig, "polar", "Reflected radiance (per unit incident irradiance) in the principal "
                "plane, sun at 30 deg: MC quad averages (phi = 0 to the right, 180 to the left; "

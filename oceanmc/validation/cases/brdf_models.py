@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
+from ...plot import half_polar
 from .. import references as ref
 from ..context import Ctx
 from ..stats import JK
@@ -376,15 +377,6 @@ def plane_of_incidence(sun: float, theta_r: np.ndarray):
     return wi, np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
 
 
-def polar_axes(ax, title: str):
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_thetamin(-90)
-    ax.set_thetamax(90)
-    ax.tick_params(labelsize=7)
-    ax.set_title(title, fontsize=9)
-
-
 def figure_f_cos(ctx: Ctx, specs: list[Model]) -> None:
     plt = _plt()
     from matplotlib.ticker import MaxNLocator
@@ -416,7 +408,7 @@ def figure_f_cos(ctx: Ctx, specs: list[Model]) -> None:
         else:
             ax.set_ylim(0.0, 1.1 * top)
             ax.yaxis.set_major_locator(MaxNLocator(3))
-        polar_axes(ax, model.label + (" (log radius)" if log_radius else "")
+        half_polar(ax, model.label + (" (log radius)" if log_radius else "")
                    + (" (arrows: the mirror)" if model.mirror else ""))
     for ax in axes.ravel()[len(specs):]:
         ax.set_visible(False)
