@@ -218,3 +218,16 @@ def test_errors_name_the_problem(mono_file, spectral_file, tmp_path, capsys):
     err = one_line_error(capsys, ["plot", str(spectral_file), "--wavelength", "555"])
     assert "--wavelength 555: not a wavelength" in err and "allowed: 400, 410," in err
     assert not list(tmp_path.glob("*.png"))
+
+
+def test_file_without_radiance_draws_the_rest(mono_file, tmp_path, capsys):
+    bare = tmp_path / "bare.h5"
+    bare.write_bytes(mono_file.read_bytes())
+    with h5py.File(bare, "a") as f:
+        for name in ("radiance", "radiance_stderr", "air/radiance", "air/radiance_stderr"):
+            del f[name]
+    assert main(["plot", str(bare)]) == 0
+    captured = capsys.readouterr()
+    assert "bare.h5 has no radiance" in captured.err and captured.err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["bare_profiles.png",
+                                                             "bare_rrs.png"]

@@ -238,9 +238,14 @@ def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
     return fig
 
 
+# the quantity each figure needs, for the note when a file lacks it
+NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed", "radiance": "radiance (tallies.radiance: false)"}
+
+
 def plot_result(path: str | Path, out: str | Path | None = None, depth: float | None = None,
-                wavelength: float | None = None) -> list[Path]:
-    """Writes the figures of a results file as PNG and returns their paths. out: a folder
+                wavelength: float | None = None) -> dict[str, Path | None]:
+    """Writes the figures of a results file as PNG; returns each figure's path by name (rrs,
+    profiles, radiance), None for one the file has no data for. out: a folder
     (existing, or ending in '/'), the files then named after the results file, or a prefix to
     which _rrs.png, _profiles.png, _radiance.png are appended; by default the results file's
     path without .h5."""
@@ -254,7 +259,8 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
     figures = {"rrs": rrs_figure(result), "profiles": profiles_figure(result, indices),
                "radiance": radiance_figure(result, at_depth, radiance_wavelength)}
     prefix.parent.mkdir(parents=True, exist_ok=True)
-    return [save(fig, f"{prefix}_{name}.png") for name, fig in figures.items() if fig is not None]
+    return {name: None if fig is None else save(fig, f"{prefix}_{name}.png")
+            for name, fig in figures.items()}
 
 
 def _prefix(path: Path, out: str | Path | None) -> Path:
