@@ -67,8 +67,13 @@ def open_result(path: str | Path) -> ResultFile:
     return ResultFile(water, air, path)
 
 
-def _listed(values: np.ndarray) -> str:
-    return ", ".join(f"{v:g}" for v in values)
+def _listed(values: np.ndarray, most: int = 12) -> str:
+    """The values for a one-line message: all of them, or the first and last few of a long
+    list."""
+    text = [f"{v:g}" for v in values]
+    if len(text) > most:
+        text = text[:most // 2] + [f"... ({len(text)} values)"] + text[-(most // 2):]
+    return ", ".join(text)
 
 
 def depth_index(result: ResultFile, depth: float | None) -> int:
