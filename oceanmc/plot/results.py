@@ -230,8 +230,9 @@ def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
             norm = log_norm(values)
             if norm is not None:
                 mesh = polar_quads(ax, radius_edges, phi_edges, values, norm)
-                fig.colorbar(mesh, ax=ax, shrink=0.75, pad=0.1,
-                             label=radiance.attrs.get("units", ""))
+                bar = fig.colorbar(mesh, ax=ax, shrink=0.75, pad=0.1)
+                bar.set_label(radiance.attrs.get("units", ""), fontsize=8)
+                bar.ax.tick_params(labelsize=7)
             ax.set_ylim(0.0, 90.0)
             ax.set_yticks([30, 60, 90])
             ax.tick_params(labelsize=7)
