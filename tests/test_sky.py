@@ -34,6 +34,7 @@ from oceanmc import scene
 from oceanmc.scene import sky as sky_packer
 from oceanmc.scene import sky_maps
 from oceanmc.config import ConfigError, load_config
+from oceanmc.kernel.rng import batch_state
 from oceanmc.kernel.sources import sky_many
 
 from conftest import REPO
@@ -58,7 +59,7 @@ def base(sky, **over):
 
 def draw(sky, n, seed=1, **over):
     sc = scene.build(load_config(base(sky, **over)))
-    return sky_many(sc.sky, sc.sf, n, seed)
+    return sky_many(sc.sky, sc.sf, n, batch_state(seed, 0))
 
 
 def view_angles(u):
@@ -147,7 +148,7 @@ def test_cosine_map_sampling(tmp_path):
     np.testing.assert_allclose(cell_l, expected_weight, rtol=1e-12)
     assert np.sum(solid_cos * expected_weight) == pytest.approx(1.0, rel=1e-12)
     n = 300_000
-    u = sky_many(sc.sky, sc.sf, n, 2)
+    u = sky_many(sc.sky, sc.sf, n, batch_state(2, 0))
     assert np.all(u[:, 2] > 0.0)
     np.testing.assert_allclose(np.linalg.norm(u[:, :3], axis=1), 1.0, atol=1e-12)
     t, p = view_angles(u)
@@ -232,7 +233,9 @@ def test_harrison_coombes_sampling():
     ref = np.array([[hc_cos_integral(sun, a, b, c, d, split=2) for c, d in zip(p_e[:-1],
                                                                                 p_e[1:])]
                     for a, b in zip(t_e[:-1], t_e[1:])]) / total
-    z = assert_z(est, ref, est_se, rel_max=0.08, what="Harrison-Coombes weighted bins")
+    # the cap guards against a gross error: the dimmest bins (near the horizon) have a 4.6%
+    # standard error, so 0.15 is 3.3 of those (seeds 3-8: max |z| 2.4-3.4, z mean 0, sd 1)
+    z = assert_z(est, ref, est_se, rel_max=0.15, what="Harrison-Coombes weighted bins")
     # the brightest bin per solid angle is beside the sun (phi of travel -30..30 deg)
     per_sr = ref / -np.diff(np.cos(np.radians(t_e)))[:, None]
     assert np.unravel_index(np.argmax(per_sr), ref.shape)[1] in (5, 6)

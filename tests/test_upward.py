@@ -13,6 +13,7 @@ from scipy import integrate
 import oceanmc
 from oceanmc import scene
 from oceanmc.kernel import upward
+from oceanmc.kernel.rng import batch_state
 
 from stats_helpers import assert_same, assert_z, dof_of
 
@@ -35,13 +36,12 @@ def arrays(a=0.1, b=0.4, fraction=FRACTION):
 
 
 @njit(cache=False)
-def _draw(sc, n, seed, ux, uy, uz):
+def _draw(sc, n, rng, ux, uy, uz):
     medium, mf, mi = sc
-    np.random.seed(seed)
     weights = np.empty(n)
     up = np.empty(n)
     for i in range(n):
-        w, nx, ny, nz = upward.scatter(medium[0], mf, mi, 0, 1.0, ux, uy, uz)
+        w, nx, ny, nz = upward.scatter(medium[0], mf, mi, 0, 1.0, ux, uy, uz, rng)
         weights[i] = w
         up[i] = -nz
     return weights, up
@@ -73,8 +73,8 @@ def test_biased_sampler_keeps_every_ring(theta_in_deg):
     sc = arrays()
     theta = math.radians(theta_in_deg)
     # up is -z: a direction at theta from straight up has uz = -cos(theta)
-    weights, up = _draw((sc.medium, sc.mf, sc.mi), N_DRAWS, 7, math.sin(theta), 0.0,
-                        -math.cos(theta))
+    weights, up = _draw((sc.medium, sc.mf, sc.mi), N_DRAWS, batch_state(7, 0), math.sin(theta),
+                        0.0, -math.cos(theta))
     assert weights.max() <= 1.0 / (1.0 - FRACTION) * (1.0 + 1e-12)
     assert np.all(weights > 0.0)
     ring = np.digitize(up, RING_EDGES[1:-1])

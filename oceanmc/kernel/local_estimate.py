@@ -16,12 +16,11 @@ A mirror bottom has no density to evaluate, so scenes with one do not use these 
 """
 import math
 
-import numpy as np
-
 from .brdf import dispatch as brdf
 from .compile import internal
 from .geometry import from_angles
 from .phase import dispatch as phase
+from .rng import uniform
 from .surface import dispatch as surface_bsdf
 
 
@@ -109,7 +108,8 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, seg, layer, z, w_
 
 
 @internal
-def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, ux, uy, uz):
+def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, ux, uy, uz,
+              rng):
     """A packet of weight w travelling (ux, uy, uz) meets the bottom (in the BRDF's local frame
     (x, -y, -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
     directions, and the polar-cap average from one direction W drawn uniformly in the cap (an
@@ -125,19 +125,19 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, 
             f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
             add_to_levels(est, ef, ei, grid, gf, tally, z, tau_b, k, w * f, -dz)
     if est.cap_on:
-        mu = 1.0 - np.random.random() * (1.0 - est.cos_water)
-        ox, oy, oz = from_angles(mu, 2.0 * math.pi * np.random.random())
+        mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
+        ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, oz)
         for level in range(grid.n_depths):
             if gf[grid.level_z + level] <= z:
                 tally[grid.cap + level] += w * f * math.exp(
                     -(tau_b - gf[grid.level_tau + level]) / mu)
         n = surface.n_water
-        mu_a = 1.0 - np.random.random() * (1.0 - est.cos_air)
+        mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
         sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
         t = surface_bsdf.transmittance(surface, mu_w)
-        phi = 2.0 * math.pi * np.random.random()
+        phi = 2.0 * math.pi * uniform(rng)
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, sin_w * math.cos(phi),
                                 -sin_w * math.sin(phi), mu_w)
         tally[grid.cap + grid.n_depths] += w * f * math.exp(-tau_b / mu_w) * t / (n * n)

@@ -9,19 +9,20 @@ from .brdf.general import first_above
 from .compile import kernel, setup
 from .geometry import from_angles
 from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP, SKY_MAP_COSINE
+from .rng import uniform
 
 
 @kernel
-def sky_cosine(sky_model):
+def sky_cosine(sky_model, rng):
     """Cosine of the travel direction's angle from nadir for a sky photon: density proportional to
     L(theta) cos(theta). Uniform L: cos = sqrt(u). Cardioidal L ~ 1 + 2 cos: the cosine-weighted
     draw is accepted with probability (1 + 2 cos)/3 (rejection, exact)."""
     if sky_model == SKY_CARDIOIDAL:
         while True:
-            mu = math.sqrt(np.random.random())
-            if 3.0 * np.random.random() < 1.0 + 2.0 * mu:
+            mu = math.sqrt(uniform(rng))
+            if 3.0 * uniform(rng) < 1.0 + 2.0 * mu:
                 return mu
-    return math.sqrt(np.random.random())
+    return math.sqrt(uniform(rng))
 
 
 @kernel
@@ -37,7 +38,7 @@ def harrison_coombes(sf, p, ux, uy, uz):
 
 
 @kernel
-def sky_direction(sky, sf):
+def sky_direction(sky, sf, rng):
     """(ux, uy, uz, weight factor) of a sky photon's travel direction. Tabulated skies: a row by
     the marginal CDF, a cell by the row's conditional CDF, sin^2(theta) and phi uniform within
     the cell (density exactly proportional to the cell's L cos); the map gives the view
@@ -50,19 +51,19 @@ def sky_direction(sky, sf):
     if model == SKY_MAP or model == SKY_HARRISON_COOMBES or model == SKY_MAP_COSINE:
         n_cols = sky.n_cols
         if model == SKY_MAP_COSINE:
-            s = np.random.random()
-            phi_view = sf[sky.phi_edges] + 2.0 * math.pi * np.random.random()
+            s = uniform(rng)
+            phi_view = sf[sky.phi_edges] + 2.0 * math.pi * uniform(rng)
             # the cell holding (s, phi_view): one before the first edge above it (the last cell
             # if rounding puts phi_view on the final edge)
             row = first_above(sf, sky.s_edges, sky.n_rows + 1, s) - 1
             col = first_above(sf, sky.phi_edges, n_cols + 1, phi_view) - 1
         else:
-            row = first_above(sf, sky.row_cdf, sky.n_rows, np.random.random())
-            col = first_above(sf, sky.cell_cdf + row * n_cols, n_cols, np.random.random())
+            row = first_above(sf, sky.row_cdf, sky.n_rows, uniform(rng))
+            col = first_above(sf, sky.cell_cdf + row * n_cols, n_cols, uniform(rng))
             s0 = sf[sky.s_edges + row]
-            s = s0 + np.random.random() * (sf[sky.s_edges + row + 1] - s0)
+            s = s0 + uniform(rng) * (sf[sky.s_edges + row + 1] - s0)
             p0 = sf[sky.phi_edges + col]
-            phi_view = p0 + np.random.random() * (sf[sky.phi_edges + col + 1] - p0)
+            phi_view = p0 + uniform(rng) * (sf[sky.phi_edges + col + 1] - p0)
         sin_t = math.sqrt(min(1.0, max(0.0, s)))
         uz = math.sqrt(max(0.0, 1.0 - s))
         ux = -sin_t * math.cos(phi_view)
@@ -73,19 +74,19 @@ def sky_direction(sky, sf):
         if model == SKY_MAP_COSINE:
             return ux, uy, uz, cell_l
         return ux, uy, uz, 1.0
-    mu = sky_cosine(model)
-    ux, uy, uz = from_angles(mu, 2.0 * math.pi * np.random.random())
+    mu = sky_cosine(model, rng)
+    ux, uy, uz = from_angles(mu, 2.0 * math.pi * uniform(rng))
     return ux, uy, uz, 1.0
 
 
 @setup
-def sky_many(sky_record, sf, n, seed):
-    """Rows (ux, uy, uz, weight factor) of n sky photons from seed (tests and reports)."""
-    np.random.seed(seed)
+def sky_many(sky_record, sf, n, rng):
+    """Rows (ux, uy, uz, weight factor) of n sky photons drawn from the stream rng (tests and
+    reports)."""
     sky = sky_record[0]
     out = np.empty((n, 4))
     for k in range(n):
-        ux, uy, uz, m = sky_direction(sky, sf)
+        ux, uy, uz, m = sky_direction(sky, sf, rng)
         out[k, 0] = ux
         out[k, 1] = uy
         out[k, 2] = uz

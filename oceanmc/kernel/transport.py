@@ -21,13 +21,10 @@ roulette_weight; optionally, scattering biased toward straight up (upward.py) an
 heavy packets. Analog mode decides each of these with a random draw instead. Either way every
 quantity has the same expectation; only the variance differs.
 
-The random draws come in the same order as in the kernel before the event loop (the flat
-surface with n_water = 1 aside, where the old loop drew one number it did not need), so runs
-are reproduced bit for bit (benchmarks/regression.md).
+Every draw comes from the batch's own stream (kernel/rng.py), passed down as `rng`; it is
+kept apart from the PACKET record, so split copies do not copy it.
 """
 import math
-
-import numpy as np
 
 from . import local_estimate, upward
 from .brdf import dispatch as brdf
@@ -36,6 +33,7 @@ from .geometry import turn
 from .models import (BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, BUDGET_SURFACE_REFLECTION,
                      BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
 from .phase import dispatch as phase
+from .rng import uniform
 from .sources import sky_direction
 from .surface import dispatch as surface_bsdf
 from .tally import score_crossing
@@ -51,8 +49,8 @@ PLANE_BOTTOM = 2
 
 
 @internal
-def exponential():
-    return -math.log(1.0 - np.random.random())
+def exponential(rng):
+    return -math.log(1.0 - uniform(rng))
 
 
 @internal
@@ -81,12 +79,12 @@ def copy_packet(dst, src):
 
 
 @internal
-def survives_roulette(ctrl, p):
+def survives_roulette(ctrl, p, rng):
     """Below the threshold a packet survives with probability s and then carries w/s, so the
     expected weight is unchanged."""
     if ctrl.analog or p.w >= ctrl.roulette_weight:
         return True
-    if np.random.random() < ctrl.roulette_survival:
+    if uniform(rng) < ctrl.roulette_survival:
         p.w /= ctrl.roulette_survival
         return True
     return False
@@ -110,7 +108,7 @@ def split(ctrl, stack, n_stacked, p):
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
+def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters in one call."""
@@ -119,7 +117,7 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
     score_crossing(grid, gf, gi, tally, air, w, p.ux, p.uy, p.uz, p.beam)
     r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     if ctrl.analog:
-        reflected = r > 0.0 and np.random.random() < r
+        reflected = r > 0.0 and uniform(rng) < r
         w_reflected = w if reflected else 0.0
     else:
         reflected = False
@@ -139,7 +137,7 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p):
 
 
 @internal
-def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau):
+def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
     """Moves the packet through its segment with tau optical depths left to its next
     collision: (FLIGHT_COLLISION, layer, 0) at a collision, (FLIGHT_PLANE, plane, tau left) on
     reaching the plane ahead, or (FLIGHT_GONE, -1, 0) when a layer that does not scatter
@@ -173,7 +171,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau):
     elif c > 0.0:
         transmitted = math.exp(-c * dist)
         if ctrl.analog:
-            if np.random.random() >= transmitted:
+            if uniform(rng) >= transmitted:
                 tally[budget + BUDGET_LAYERS + layer] += p.w
                 return FLIGHT_GONE, -1, 0.0
         else:
@@ -187,7 +185,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau):
 
 
 @internal
-def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events):
+def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
     albedo = mf[medium.layer_albedo + layer]
@@ -197,7 +195,7 @@ def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events
                                     p.z, w * albedo, p.ux, p.uy, p.uz)
     budget = grid.budget
     if ctrl.analog:
-        if np.random.random() >= albedo:
+        if uniform(rng) >= albedo:
             tally[budget + BUDGET_LAYERS + layer] += w
             return False, 0.0
     else:
@@ -205,18 +203,18 @@ def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events
         tally[budget + BUDGET_LAYERS + layer] += w - scattered
         w = scattered
     if ctrl.upward:
-        w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz)
+        w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz, rng)
     else:
-        u_pick = np.random.random() if mi[medium.comp_count + layer] > 1 else 0.0
-        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, np.random.random())
-        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, np.random.random())
+        u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
+        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, uniform(rng))
+        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
     p.w = w
     p.ux = ux
     p.uy = uy
     p.uz = uz
     p.beam = 0
-    tau = exponential()
-    if not survives_roulette(ctrl, p):
+    tau = exponential(rng)
+    if not survives_roulette(ctrl, p, rng):
         return False, tau
     if events >= ctrl.max_events:
         tally[budget + BUDGET_TRUNCATED] += p.w
@@ -225,7 +223,7 @@ def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p):
+def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -233,11 +231,11 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p):
     r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     w = p.w
     if ctrl.analog:
-        goes_on = r > 0.0 and np.random.random() < r
+        goes_on = r > 0.0 and uniform(rng) < r
         leaving = 0.0 if goes_on else w
     else:
         leaving = w * (1.0 - r)
-        goes_on = r > 0.0 and (r >= 1.0 or np.random.random() < r)
+        goes_on = r > 0.0 and (r >= 1.0 or uniform(rng) < r)
     if leaving > 0.0:
         air = grid.air_level
         score_crossing(grid, gf, gi, tally, air, leaving, tx, ty, tz, p.beam)
@@ -253,7 +251,8 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p):
 
 
 @internal
-def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, p):
+def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, p,
+                      rng):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
@@ -263,15 +262,15 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
         return False
     if est.directions_on or est.cap_on:
         local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
-                                 p.w, p.ux, p.uy, p.uz)
-    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, np.random.random(),
-                                   np.random.random())
+                                 p.w, p.ux, p.uy, p.uz, rng)
+    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, uniform(rng),
+                                   uniform(rng))
     p.ux = ux
     p.uy = uy
     p.uz = uz
     p.beam = 1 if (p.beam != 0 and bottom.mirror != 0) else 0
     if ctrl.analog:
-        if np.random.random() >= rho:
+        if uniform(rng) >= rho:
             tally[budget + BUDGET_BOTTOM] += p.w
             return False
     else:
@@ -298,28 +297,35 @@ def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
 
 
 @internal
-def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level):
+def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level, rng):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
         score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
         n_stacked = split(ctrl, stack, n_stacked, p)
-    return survives_roulette(ctrl, p), n_stacked
+    return survives_roulette(ctrl, p, rng), n_stacked
 
 
 @batch
 def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
-                est_row, ef, ei, ctrl_row, n_photons, seed, tally, packet_row, stack):
-    """One batch: its own random stream (seeded from (seed, batch) by the caller; Numba's
-    generator state is per thread, and a batch runs in one thread), n_photons packets whose
-    weights add up to n_photons. The sky's share is stratified: round(f n) packets come from the
-    sky and carry f n / n_sky each, the rest from the sun; returns the number of scattering
-    events. A photon's split copies (stack) are traced before the next photon. The records come
-    as one-row arrays; the GIL is released, so batches run in parallel threads."""
+                est_row, ef, ei, ctrl_row, n_photons, start, work_budget, rng, beam_in, tally,
+                packet_row, stack):
+    """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
+    n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
+    per photon and per scattering event): returns (next photon index, scattering events).
+
+    A batch may thus be traced in any number of calls, each continuing where the last stopped,
+    with the same draws and the same additions in the same order as one call: its state between
+    calls is its random stream rng (kernel/rng.py, advanced in place), the next photon index
+    (-1 at the start), its tally row, and beam_in, the entered solar beam (weight per sun
+    packet and direction below the surface) that packet -1 computes once per batch in implicit
+    mode; the split stack is empty between photons. The sky's share is stratified: round(f n)
+    packets come from the sky and carry f n / n_sky each, the rest from the sun. A photon's
+    split copies (stack) are traced before the next photon. The records come as one-row
+    arrays; the GIL is released, so batches run in parallel threads."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
     grid, est, ctrl, p = grid_row[0], est_row[0], ctrl_row[0], packet_row[0]
-    np.random.seed(seed)
     f = sky.diffuse_fraction
     if f <= 0.0:
         n_sky = 0
@@ -334,17 +340,19 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     # in implicit mode every sun packet enters the same way, so the whole beam of the batch
     # enters once, as packet -1, before the others, and each sun packet starts below the surface
     beam_once = not analog and n_sun > 0
-    w_sun_in, sx, sy, sz = 0.0, 0.0, 0.0, 1.0
+    w_sun_in, sx, sy, sz = beam_in[0], beam_in[1], beam_in[2], beam_in[3]
     events = 0
     n_stacked = 0   # the split stack is empty between photons
-    for i in range(-1, n_photons):
+    for i in range(start, n_photons):
+        if i > start and events + (i - start) >= work_budget:
+            return i, events
         from_sky = 0 <= i < n_sky
         if i < 0:
             if not beam_once:
                 continue
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun * n_sun
         elif from_sky:
-            ux, uy, uz, weight = sky_direction(sky, sf)
+            ux, uy, uz, weight = sky_direction(sky, sf, rng)
             w = weight * w_sky
         elif analog:
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun
@@ -352,35 +360,37 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         launch(p, w, ux, uy, uz, not from_sky)
         if (i < 0 or from_sky or analog) and not enter_from_air(surface, ctrl, grid, gf, gi,
-                                                                tally, p):
+                                                                tally, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
+            beam_in[0], beam_in[1], beam_in[2], beam_in[3] = w_sun_in, sx, sy, sz
             continue
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, stack, n_stacked, p)
         while True:
             # the walk of packet p as a sequence of events, until it leaves, is absorbed or
             # loses roulette; then the next of its split copies, if any
-            tau = exponential()
+            tau = exponential(rng)
             alive = True
             walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
-                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau)
+                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau,
+                                                  rng)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
                     alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p,
-                                         where, walk_events)
+                                         where, walk_events, rng)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
                     if plane == PLANE_SURFACE:
-                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p)
+                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf,
-                                                  est, ef, ei, tally, p)
+                                                  est, ef, ei, tally, p, rng)
                     if alive and plane != PLANE_INSIDE:
                         alive, n_stacked = after_reflection(ctrl, grid, gf, gi, tally, stack,
-                                                            n_stacked, p, level)
+                                                            n_stacked, p, level, rng)
                 else:
                     alive = False
             events += walk_events
@@ -388,4 +398,4 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                 break
             n_stacked -= 1
             copy_packet(p, stack[n_stacked])
-    return events
+    return n_photons, events

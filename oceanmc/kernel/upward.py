@@ -19,27 +19,26 @@ f <= 1 - w0 (scene/medium.py), so no scattering event makes a packet heavier: wi
 """
 import math
 
-import numpy as np
-
 from .compile import kernel
 from .geometry import cos_sin_turn, turn
 from .phase import dispatch as phase
+from .rng import uniform
 
 
 @kernel
-def scatter(medium, mf, mi, layer, w, ux, uy, uz):
+def scatter(medium, mf, mi, layer, w, ux, uy, uz, rng):
     """(w, ux, uy, uz) after a scattering event in `layer` of a packet of weight w (already
-    times the albedo) travelling (ux, uy, uz); up is -z."""
+    times the albedo) travelling (ux, uy, uz); up is -z; rng: the batch's random stream."""
     up_cos = medium.up_cos
-    if np.random.random() < mf[medium.up_fraction + layer]:
-        mu = 1.0 - np.random.random() * (1.0 - up_cos)
+    if uniform(rng) < mf[medium.up_fraction + layer]:
+        mu = 1.0 - uniform(rng) * (1.0 - up_cos)
         sin_t = math.sqrt(max(0.0, 1.0 - mu * mu))
-        cp, sp = cos_sin_turn(np.random.random())
+        cp, sp = cos_sin_turn(uniform(rng))
         nx, ny, nz = sin_t * cp, sin_t * sp, -mu
     else:
-        u_pick = np.random.random() if mi[medium.comp_count + layer] > 1 else 0.0
-        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, np.random.random())
-        nx, ny, nz = turn(ux, uy, uz, cos_s, np.random.random())
+        u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
+        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, uniform(rng))
+        nx, ny, nz = turn(ux, uy, uz, cos_s, uniform(rng))
     keep = mf[medium.up_keep + layer]
     if -nz > up_cos:
         p = phase.evaluate(medium, mf, mi, layer, ux * nx + uy * ny + uz * nz)

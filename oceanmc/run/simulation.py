@@ -15,6 +15,7 @@ from tqdm import tqdm
 from .. import __version__, scene
 from ..config import SceneConfig, config_to_yaml, load_config
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
+from ..kernel.rng import batch_state
 from ..scene.grid import tally_views
 from .compiling import ready
 from .results import Result, from_tallies
@@ -22,24 +23,6 @@ from .results import Result, from_tallies
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
 PACKET_STRIDE = 256 // PACKET.itemsize    # packets of two batches 256 bytes apart
-
-
-def batch_seeds(seed: int, n_batches: int) -> np.ndarray:
-    """One 32-bit seed per batch, a function of (seed, batch index) only (numpy SeedSequence with
-    the batch index as spawn key), so batch b is the same whatever the batch count or grouping.
-    Numba's generator takes 32-bit seeds; a rare collision inside a run is re-derived."""
-    seeds = []
-    seen = set()
-    for b in range(n_batches):
-        attempt = 0
-        while True:
-            s = int(np.random.SeedSequence(seed, spawn_key=(b, attempt)).generate_state(1)[0])
-            if s not in seen:
-                break
-            attempt += 1
-        seen.add(s)
-        seeds.append(s)
-    return np.array(seeds, dtype=np.int64)
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -71,7 +54,12 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
     depths = config.tallies.depths_m
-    seeds = batch_seeds(config.seed, config.batches)[first_batch:]
+    # each batch's random stream (rows 128 bytes apart: a thread writes its state at every draw)
+    rngs = np.zeros((n_batches, 16), dtype=np.uint64)
+    for b in range(n_batches):
+        rngs[b, :4] = batch_state(config.seed, first_batch + b)
+    beams = np.zeros((n_batches, 4))
+    beams[:, 3] = 1.0
     # each batch's tally row and packet on cache lines of their own: two threads writing to
     # one line slow each other down (false sharing; measured: 1.5x instead of 2x on 2 threads)
     tallies = np.zeros((n_batches, -(-sc.tally_size // LINE_FLOATS) * LINE_FLOATS + LINE_FLOATS))
@@ -82,11 +70,13 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     raw = dict(tally_views(sc.grid, tallies), events=events)
 
     def batch(b: int) -> tuple:
-        return (n_per_batch, seeds[b], tallies[b], packets[b, :1], stacks[b])
-
+        return (rngs[b, :4], beams[b], tallies[b], packets[b, :1], stacks[b])
 
     def run_batch(b: int) -> None:
-        events[b] = trace(*sc.kernel_args(), *batch(b))
+        start = -1
+        while start < n_per_batch:
+            start, n_events = trace(*sc.kernel_args(), n_per_batch, start, 1 << 20, *batch(b))
+            events[b] += n_events
 
     def result_of(done: int, wall: float) -> Result:
         photons = done * n_per_batch
