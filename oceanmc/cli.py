@@ -63,9 +63,10 @@ def _file_size_estimate(config) -> int:
 
 
 class StopRequest:
-    """The first SIGINT or SIGTERM asks the run to stop after the batches in flight and write
-    what it has; the default handlers come back, so a second signal ends the process at once
-    (the atomic write means no results file is ever left half written)."""
+    """The first SIGINT or SIGTERM asks the run to stop (the kernel returns within a fraction of
+    a second, simulation.CALL_SECONDS) and write what it has; the default handlers come back, so
+    a second signal ends the process at once (the atomic write means no results file is ever
+    left half written)."""
 
     def __init__(self) -> None:
         self.requested = False
@@ -76,9 +77,8 @@ class StopRequest:
         self.signal_name = signal.Signals(signum).name
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        print(f"\noceanmc: {self.signal_name}: finishing the batches in flight and writing the "
-              "photons done so far; press Ctrl-C again to quit at once", file=sys.stderr,
-              flush=True)
+        print(f"\noceanmc: {self.signal_name}: stopping and writing the photons done so far; "
+              "press Ctrl-C again to quit at once", file=sys.stderr, flush=True)
 
     def install(self) -> None:
         signal.signal(signal.SIGINT, self)
@@ -124,9 +124,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     stop = StopRequest()
     stop.install()
     for path, out, config, previous in scenes:
-        first = 0
+        first, resume_state = 0, None
         if previous is not None:
             first = int(previous.attrs.get("first_batch", 0)) + int(previous.attrs["batches"])
+            resume_state = previous.resume_state
 
         def combined(result, previous=previous):
             return result if previous is None else merge_results([previous, result], resume=True)
@@ -136,7 +137,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         try:
             result = simulate(config, threads=args.threads, progress=not args.quiet,
                               first_batch=first, should_stop=lambda: stop.requested,
-                              on_checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every)
+                              on_checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every,
+                              resume_state=resume_state)
             result = combined(result)
         except ConfigError as exc:  # auxiliary tables are read when the scene is built
             print(f"oceanmc: config error: {path}: {exc}", file=sys.stderr)
@@ -156,8 +158,15 @@ def cmd_run(args: argparse.Namespace) -> int:
         if result.attrs.get("partial"):
             total = config.batches
             done = int(result.attrs["batches"])
-            print(f"  PARTIAL: {done} of {total} batches ({result.attrs['photons']:,} photons); "
-                  f"continue with: oceanmc run {path} -o {out} --resume")
+            unfinished = result.resume_state
+            begun = "" if unfinished is None else \
+                f"; {len(unfinished['batch'])} more begun, kept to be continued"
+            print(f"  PARTIAL: {done} of {total} batches whole ({result.attrs['photons']:,} "
+                  f"photons; the estimates use whole batches only){begun}; continue with: "
+                  f"oceanmc run {path} -o {out} --resume")
+            if done == 0:
+                print("  no batch is whole yet: the file holds no estimate, only the state to "
+                      "resume from")
         print()
         if stop.requested:
             print(f"oceanmc: stopped by {stop.signal_name}", file=sys.stderr)

@@ -63,7 +63,7 @@ def test_sigint_writes_a_partial_file_and_resume_completes_it_bit_for_bit(tmp_pa
     with h5py.File(out) as f:
         assert bool(f.attrs["partial"])
         done = int(f.attrs["batches"])
-        assert 1 <= done < 64
+        assert 0 <= done < 64
         assert f.attrs["photons"] == done * f.attrs["photons_per_batch"]
         assert f["batches/Ed"].shape[0] == done
 
@@ -96,11 +96,13 @@ def test_second_sigint_quits_at_once_without_a_corrupt_file(tmp_path, long_scene
     wait_for(out, proc)
     proc.send_signal(signal.SIGINT)
     time.sleep(0.01)
+    sent = time.time()
     proc.send_signal(signal.SIGINT)
     proc.communicate(timeout=300)
+    assert time.time() - sent < 1.0
     assert proc.returncode in (130, -signal.SIGINT)
     result = oceanmc.load_result(out)  # whatever is there is a whole file
-    assert result.attrs["batches"] >= 1
+    assert result.attrs["partial"]
 
 
 def test_resume_refuses_a_different_scene(tmp_path, long_scene):
@@ -138,7 +140,8 @@ def test_merge_of_independent_runs(tmp_path, small_scene):
     assert done.returncode == 0, done.stderr
     assert oceanmc.load_result(tmp_path / "c.h5").attrs["batches"] == 16
     done = run(["merge", "a.h5", "a.h5", "-o", "d.h5"], tmp_path)
-    assert done.returncode == 2 and "appears twice" in done.stderr
+    assert done.returncode == 2 and "batches 0..7 of seed 1 are in both result 1 and result 2" \
+        in done.stderr
     assert not (tmp_path / "d.h5").exists()
 
 

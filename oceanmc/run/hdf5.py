@@ -26,6 +26,13 @@ COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is
                "direction_phi": ("deg", "phi of travel of each local-estimate direction")}
 
 
+# a partial run's unfinished batches (run/simulation.py), what --resume continues them from
+RESUME_GROUP = "resume"
+RESUME_FIELDS = ("batch", "rng", "beam", "next_photon", "events", "tally")
+RESUME_DESCRIPTION = ("state of the batches begun but not finished when the run stopped, "
+                      "not part of the estimates: batch index, random stream (xoshiro256**), "
+                      "entered sun beam, next photon, scattering events, raw tally row")
+
 AUXILIARY_COORDS = {"direction_theta": "direction", "direction_phi": "direction"}
 
 
@@ -96,6 +103,11 @@ def _write(f: h5py.File, result: Result) -> None:
                    f"per-batch values of {q.name}", compression="gzip", compression_opts=4,
                    shuffle=True)
         ds.attrs["dims"] = ",".join(q.dims)
+    if result.resume_state is not None:
+        group = f.create_group(RESUME_GROUP)
+        group.attrs["description"] = RESUME_DESCRIPTION
+        for name, values in result.resume_state.items():
+            group.create_dataset(name, data=values)
 
 
 def load_result(path: str | Path) -> Result:
@@ -114,7 +126,10 @@ def load_result(path: str | Path) -> Result:
                                             _plain(obj.attrs["units"]),
                                             _plain(f[name].attrs["description"]))
         f["batches"].visititems(visit)
-    return Result(coords, quantities, attrs)
+        resume_state = None
+        if RESUME_GROUP in f:
+            resume_state = {name: f[RESUME_GROUP][name][()] for name in RESUME_FIELDS}
+    return Result(coords, quantities, attrs, resume_state)
 
 
 def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:

@@ -25,6 +25,8 @@ class Quantity:
 
     @property
     def mean(self) -> np.ndarray:
+        if self.batches.shape[0] == 0:   # a run stopped before its first batch was whole
+            return np.full(self.batches.shape[1:], np.nan)
         return self.batches.mean(axis=0)
 
     @property
@@ -40,6 +42,8 @@ class Result:
     coords: dict[str, np.ndarray]
     quantities: dict[str, Quantity]
     attrs: dict[str, object] = field(default_factory=dict)
+    # a partial run's unfinished batches, from which --resume continues them (simulation.py)
+    resume_state: dict[str, np.ndarray] | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.quantities[name].mean
@@ -73,12 +77,26 @@ def _scene_without(config_yaml: str, *keys: str) -> dict:
     return scene
 
 
+def _batch_ranges(part: Result) -> list[tuple[int, int, int]]:
+    """(seed, first batch, end) of each run a result holds: batch b of seed s is the same photons
+    in every run (rng.batch_state). A merge records them in attribute batch_ranges; a merged
+    file from before that attribute counts as all the batches of each of its seeds."""
+    if "batch_ranges" in part.attrs:
+        return [tuple(int(x) for x in r.split(":"))
+                for r in str(part.attrs["batch_ranges"]).split(",")]
+    if "seeds" in part.attrs:
+        return [(int(s), 0, 2**62) for s in str(part.attrs["seeds"]).split(",")]
+    first = int(part.attrs.get("first_batch", 0))
+    return [(int(part.attrs["seed"]), first, first + int(part.attrs["batches"]))]
+
+
 def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
     """One Result from several runs of the same scene, by concatenating their batches (the
     standard errors then come from all batches together).
 
-    Independent runs (resume=False) must differ in seed and agree on everything else but the
-    photon count; photons per batch must match so that the batches are alike. A resumed run
+    Independent runs (resume=False) must not share a batch (the same seed and batch index) and
+    must agree on everything else but the photon count; photons per batch must match so that
+    the batches are alike. A resumed run
     (resume=True) continues the batches of the same seed: the scenes must be identical and the
     batch ranges contiguous."""
     if len(parts) < 2:
@@ -96,7 +114,7 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
             expected += int(part.attrs["batches"])
     else:
         scene = _scene_without(first.config_yaml, "seed", "photons", "name")
-        seeds = []
+        ranges: list[tuple[int, int, int, int]] = []   # (seed, first, end, result number)
         for i, part in enumerate(parts):
             if _scene_without(part.config_yaml, "seed", "photons", "name") != scene:
                 raise MergeError(f"result {i + 1} is a different scene (its water, surface, "
@@ -105,12 +123,14 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
                 raise MergeError(f"result {i + 1} has {part.attrs.get('photons_per_batch')} "
                                  f"photons per batch, result 1 has "
                                  f"{first.attrs.get('photons_per_batch')}: batches must be alike")
-            part_seeds = str(part.attrs.get("seeds", part.attrs["seed"])).split(",")
-            repeated = set(seeds) & set(part_seeds)
-            if repeated:
-                raise MergeError(f"seed {sorted(repeated)[0]} appears twice: runs with the same "
-                                 "seed are the same photons, not independent ones")
-            seeds += part_seeds
+            for seed, lo, hi in _batch_ranges(part):
+                for other_seed, other_lo, other_hi, j in ranges:
+                    if seed == other_seed and max(lo, other_lo) < min(hi, other_hi):
+                        raise MergeError(
+                            f"batches {max(lo, other_lo)}..{min(hi, other_hi) - 1} of seed {seed} "
+                            f"are in both result {j} and result {i + 1}: the same photons, not "
+                            "independent ones")
+                ranges.append((seed, lo, hi, i + 1))
         if set(first.quantities) != set().union(*(p.quantities for p in parts)):
             raise MergeError("the results hold different quantities")
     quantities = {
@@ -128,9 +148,12 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
     attrs["partial"] = bool(parts[-1].attrs.get("partial", False)) if resume else \
         any(bool(p.attrs.get("partial", False)) for p in parts)
     if not resume:
-        attrs["seeds"] = ",".join(seeds)
+        attrs["seeds"] = ",".join(dict.fromkeys(str(r[0]) for r in ranges))
+        attrs["batch_ranges"] = ",".join(f"{seed}:{lo}:{hi}" for seed, lo, hi, _ in ranges)
         attrs["merged_from"] = len(parts)
-    return Result(dict(first.coords), quantities, attrs)
+    # a resumed run's unfinished batches are those of its last part
+    return Result(dict(first.coords), quantities, attrs,
+                  parts[-1].resume_state if resume else None)
 
 
 # --- building a Result from raw kernel tallies ------------------------------------------------

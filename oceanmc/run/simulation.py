@@ -1,10 +1,20 @@
-"""simulate(config) -> Result: packs the scene (scene/), runs the batches in groups on the
-compiled kernel (a progress bar between groups), and hands the tallies to results.py."""
+"""simulate(config) -> Result: packs the scene (scene/), traces the batches on the compiled
+kernel in a thread pool, and hands the tallies to results.py.
+
+A batch is traced in short calls (transport.trace_batch continues a batch where the last call
+stopped, bit for bit), each given a work budget that keeps it near CALL_SECONDS, so a stop, a
+checkpoint and the progress bar wait at most about that long whatever the photon count. A stop
+reports the leading whole batches (each batch an equal, independent sample: the mean and
+standard error over batches stay exact); the batches begun after them keep their state (random
+stream, next photon, entered sun beam, partial tally row) in Result.resume_state, from which a
+resumed run continues them exactly."""
 from __future__ import annotations
 
 import math
+import sys
+import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
 from pathlib import Path
 from typing import Any, Callable
 
@@ -15,7 +25,7 @@ from tqdm import tqdm
 from .. import __version__, scene
 from ..config import SceneConfig, config_to_yaml, load_config
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
-from ..kernel.rng import batch_state
+from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
 from .compiling import ready
 from .results import Result, from_tallies
@@ -23,20 +33,41 @@ from .results import Result, from_tallies
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
 PACKET_STRIDE = 256 // PACKET.itemsize    # packets of two batches 256 bytes apart
+RNG_STRIDE = 16                           # random states 128 bytes apart (written at every draw)
+CALL_SECONDS = 0.2      # aimed length of one kernel call: the latency of a stop or a checkpoint
+FIRST_BUDGET = 1 << 12  # work units (photons + scattering events) of a batch's first call
+MIN_BUDGET = 1 << 8
+POLL_SECONDS = 0.25     # how often the main thread looks at stops, checkpoints and progress
+ESTIMATE_AFTER_S = 3.0  # tracing time before a run's duration is estimated
+LONG_RUN_S = 3600.0     # a run estimated longer than this says so at its start
+
+
+def next_budget(budget: int, seconds: float) -> int:
+    """The work budget of a batch's next call from the last one's: scaled toward CALL_SECONDS,
+    by at most 4x per call. The budget only decides where calls end, never what is traced."""
+    factor = min(4.0, max(0.25, CALL_SECONDS / max(seconds, 1e-6)))
+    return int(min(max(budget * factor, MIN_BUDGET), 1 << 40))
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds / 3600:.1f} h" if seconds < 48 * 3600 else f"{seconds / 86400:.1f} days"
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
              progress: bool = False, first_batch: int = 0,
              should_stop: Callable[[], bool] | None = None,
              on_checkpoint: Callable[[Result], None] | None = None,
-             checkpoint_every_s: float = 60.0) -> Result:
+             checkpoint_every_s: float = 60.0,
+             resume_state: dict[str, np.ndarray] | None = None) -> Result:
     """Runs a scene (a SceneConfig, a dict or a YAML path) and returns its Result.
 
     Batches first_batch .. batches-1 are traced, `threads` at a time (a resumed run starts
-    after the batches it already has; batch b is the same whatever the start). After each
-    batch, should_stop() may end the run early: the Result then holds the batches completed and is
-    marked partial. on_checkpoint(result) receives the batches completed so far every
-    checkpoint_every_s seconds."""
+    after the whole batches it already has; batch b is the same whatever the start), continuing
+    those in resume_state (a partial Result's) where they stopped. Every CALL_SECONDS or so,
+    should_stop() may end the run early: the Result then holds the leading whole batches, the
+    state of the later ones begun, and is marked partial. on_checkpoint(result) receives such a
+    partial Result every checkpoint_every_s seconds. progress: a progress bar on stderr, and a
+    notice there when the run looks like taking more than an hour."""
     if not isinstance(config, SceneConfig):
         config = load_config(config)
     # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
@@ -54,31 +85,66 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
     depths = config.tallies.depths_m
-    # each batch's random stream (rows 128 bytes apart: a thread writes its state at every draw)
-    rngs = np.zeros((n_batches, 16), dtype=np.uint64)
+    # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
+    # beam (weight per sun packet, direction), scattering events, tally row
+    rngs = np.zeros((n_batches, RNG_STRIDE), dtype=np.uint64)
     for b in range(n_batches):
-        rngs[b, :4] = batch_state(config.seed, first_batch + b)
+        rngs[b, :STATE_WORDS] = batch_state(config.seed, first_batch + b)
     beams = np.zeros((n_batches, 4))
     beams[:, 3] = 1.0
+    next_photon = np.full(n_batches, -1, dtype=np.int64)
     # each batch's tally row and packet on cache lines of their own: two threads writing to
     # one line slow each other down (false sharing; measured: 1.5x instead of 2x on 2 threads)
     tallies = np.zeros((n_batches, -(-sc.tally_size // LINE_FLOATS) * LINE_FLOATS + LINE_FLOATS))
     events = np.zeros(n_batches, dtype=np.int64)
+    if resume_state is not None:
+        _restore(resume_state, first_batch, n_batches, sc.tally_size, rngs, beams, next_photon,
+                 events, tallies)
     packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
     stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
     raw = dict(tally_views(sc.grid, tallies), events=events)
-
-    def batch(b: int) -> tuple:
-        return (rngs[b, :4], beams[b], tallies[b], packets[b, :1], stacks[b])
+    args = sc.kernel_args()
+    # a batch's lock is held through each of its calls, so that a checkpoint copies its state
+    # between two calls
+    locks = [threading.Lock() for _ in range(n_batches)]
+    stopping = threading.Event()
+    photons_before = int(np.maximum(next_photon, 0).sum())
 
     def run_batch(b: int) -> None:
-        start = -1
-        while start < n_per_batch:
-            start, n_events = trace(*sc.kernel_args(), n_per_batch, start, 1 << 20, *batch(b))
-            events[b] += n_events
+        budget = FIRST_BUDGET
+        while not stopping.is_set():
+            with locks[b]:
+                if next_photon[b] >= n_per_batch:
+                    return
+                t = time.perf_counter()
+                next_photon[b], n_events = trace(*args, n_per_batch, next_photon[b], budget,
+                                                 rngs[b, :STATE_WORDS], beams[b], tallies[b],
+                                                 packets[b, :1], stacks[b])
+                events[b] += n_events
+            budget = next_budget(budget, time.perf_counter() - t)
 
-    def result_of(done: int, wall: float) -> Result:
+    def result_of(wall: float) -> Result:
+        """The leading whole batches, and the state of the later ones begun."""
+        done = 0
+        while done < n_batches and next_photon[done] >= n_per_batch:
+            done += 1
+        begun = [b for b in range(done, n_batches) if next_photon[b] >= 0]
+        state = None
+        if begun:
+            state = {"batch": np.array(begun, dtype=np.int64) + first_batch,
+                     "rng": np.empty((len(begun), STATE_WORDS), dtype=np.uint64),
+                     "beam": np.empty((len(begun), 4)),
+                     "next_photon": np.empty(len(begun), dtype=np.int64),
+                     "events": np.empty(len(begun), dtype=np.int64),
+                     "tally": np.empty((len(begun), sc.tally_size))}
+            for k, b in enumerate(begun):
+                with locks[b]:
+                    state["rng"][k] = rngs[b, :STATE_WORDS]
+                    state["beam"][k] = beams[b]
+                    state["next_photon"][k] = next_photon[b]
+                    state["events"][k] = events[b]
+                    state["tally"][k] = tallies[b, :sc.tally_size]
         photons = done * n_per_batch
         attrs = {
             "name": config.name,
@@ -98,32 +164,71 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "scattering_events": int(raw["events"][:done].sum()),
         }
         part = {name: values[:done] for name, values in raw.items()}
-        return from_tallies(part, sc.angles, np.array(depths), n_per_batch,
-                            config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
-                            config.tallies.local_directions_deg, sc.local_rows,
-                            config.nadir_local)
+        result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
+                              config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
+                              config.tallies.local_directions_deg, sc.local_rows,
+                              config.nadir_local)
+        result.resume_state = state
+        return result
 
-    done = 0
     t1 = last_checkpoint = time.perf_counter()
-    with tqdm(total=n_batches * n_per_batch, unit="photon", unit_scale=True, delay=1.0,
-              disable=not progress, desc=config.name[:40], leave=False) as bar, \
-            ThreadPoolExecutor(max_workers=n_threads) as pool:
-        # every batch queued at once (no barrier between groups); they finish in about the
-        # order queued and are counted in order, so a stop keeps a prefix of whole batches
+    estimated = False
+    with tqdm(total=n_batches * n_per_batch, initial=photons_before, unit="photon",
+              unit_scale=True, delay=1.0, disable=not progress, desc=config.name[:40],
+              leave=False) as bar, ThreadPoolExecutor(max_workers=n_threads) as pool:
+        # every batch queued at once, in order: they finish in about that order, so a stop
+        # leaves few begun batches after the whole ones
         futures = [pool.submit(run_batch, b) for b in range(n_batches)]
         try:
-            for future in futures:
-                future.result()
-                done += 1
-                bar.update(n_per_batch)
+            while True:
+                finished, running = wait(futures, timeout=POLL_SECONDS,
+                                         return_when=FIRST_EXCEPTION)
+                for future in finished:
+                    future.result()   # a batch's exception, raised here
+                photons_now = int(np.maximum(next_photon, 0).sum())
+                bar.update(photons_now - bar.n)
+                if not running:
+                    break
                 if should_stop is not None and should_stop():
                     break
                 now = time.perf_counter()
-                if on_checkpoint is not None and done < n_batches \
-                        and now - last_checkpoint >= checkpoint_every_s:
-                    on_checkpoint(result_of(done, now - t1))
+                if progress and not estimated and now - t1 >= ESTIMATE_AFTER_S \
+                        and photons_now > photons_before:
+                    estimated = True
+                    rate = (photons_now - photons_before) / (now - t1)
+                    left = (n_batches * n_per_batch - photons_now) / rate
+                    if left > LONG_RUN_S:
+                        bar.write(f"oceanmc: {config.name}: about {_duration(left)} to go at "
+                                  f"{rate:,.0f} photons/s; Ctrl-C stops it within seconds and "
+                                  "writes what is done (--resume continues it)", file=sys.stderr)
+                if on_checkpoint is not None and now - last_checkpoint >= checkpoint_every_s:
+                    on_checkpoint(result_of(now - t1))
                     last_checkpoint = now
         finally:
-            for future in futures[done:]:
-                future.cancel()   # the batches in flight finish; the rest never start
-    return result_of(done, time.perf_counter() - t1)
+            # the calls in flight end within about CALL_SECONDS; batches not begun never start
+            stopping.set()
+            for future in futures:
+                future.cancel()
+            wait(futures)
+    for future in futures:
+        if not future.cancelled():
+            future.result()
+    return result_of(time.perf_counter() - t1)
+
+
+def _restore(state: dict[str, np.ndarray], first_batch: int, n_batches: int, tally_size: int,
+             rngs, beams, next_photon, events, tallies) -> None:
+    """Puts a partial run's unfinished batches (Result.resume_state) back where they stopped."""
+    if state["tally"].shape[1:] != (tally_size,):
+        raise ValueError(f"the stored unfinished batches have {state['tally'].shape[1:]} "
+                         f"tally values each, this scene {tally_size}")
+    for k, batch in enumerate(state["batch"]):
+        b = int(batch) - first_batch
+        if not 0 <= b < n_batches:
+            raise ValueError(f"stored unfinished batch {batch} is outside {first_batch} .. "
+                             f"{first_batch + n_batches - 1}")
+        rngs[b, :STATE_WORDS] = state["rng"][k]
+        beams[b] = state["beam"][k]
+        next_photon[b] = state["next_photon"][k]
+        events[b] = state["events"][k]
+        tallies[b, :tally_size] = state["tally"][k]
