@@ -10,11 +10,17 @@ output quantity's mean and standard error. Run it once with the old kernel on th
 (PYTHONPATH=/path/to/old/checkout) and once with the new one.
 
 `compare` matches the scenes and quantities of the two files and computes, for every element,
-z = (after - before) / sqrt(se_before^2 + se_after^2). Elements whose standard errors are both
-zero (exact quantities, e.g. the scored direct beam) must agree to 1e-12 relative. The bound is
-Bonferroni-corrected for the number of elements compared: a family-wise false-alarm rate of 1%
-two-sided, |z| <= Phi^-1(1 - 0.005 / N). Identical random streams give z = 0 everywhere;
-the report says how many elements are bit-identical. Exit status 1 if any element fails.
+z = (after - before) / sqrt(se_before^2 + se_after^2). Each standard error comes from a scene's
+batches (as few as 2 in some validation scenes), so z is Student-t distributed with the
+Welch-Satterthwaite degrees of freedom nu = (s0^2 + s1^2)^2 / (s0^4 / (n0 - 1) + s1^4 / (n1 - 1))
+(Welch 1947, Biometrika 34, 28): it is reported as the normal z of the same two-sided tail
+probability (as is, where a recording has no batch counts). Elements whose standard errors are
+both zero must agree to 1e-12 relative, unless the scene has fewer than EXACT_MIN_BATCHES
+batches: there two equal batch values (one photon in a quad in each) happen by chance, and such
+elements are counted, not tested. The bound is Bonferroni-corrected for the number of elements
+compared: a family-wise false-alarm rate of 1% two-sided, |z| <= Phi^-1(1 - 0.005 / N).
+Identical random streams give z = 0 everywhere; the report says how many elements are
+bit-identical. Exit status 1 if any element fails.
 """
 from __future__ import annotations
 
@@ -30,12 +36,14 @@ from scipy import stats
 
 ROOT = Path(__file__).resolve().parent.parent
 FAMILY_ALPHA = 0.01
+EXACT_MIN_BATCHES = 8
 
 
 def _store(store: dict, key: str, result) -> None:
     for name, q in result.quantities.items():
         store[f"{key}|{name}|mean"] = np.asarray(q.mean, dtype=np.float64)
         store[f"{key}|{name}|stderr"] = np.asarray(q.stderr, dtype=np.float64)
+    store[f"{key}|batches"] = np.asarray(result.attrs["batches"])
 
 
 def record(out: Path, configs_dir: Path, cases: list[str] | None) -> int:
@@ -78,12 +86,17 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
             labels: tuple[str, str] = ("before", "after")) -> int:
     before = np.load(before_path)
     after = np.load(after_path)
-    keys = sorted({k.rsplit("|", 1)[0] for k in before.files})
-    keys_after = sorted({k.rsplit("|", 1)[0] for k in after.files})
+    keys = sorted({k.rsplit("|", 1)[0] for k in before.files if k.count("|") == 2})
+    keys_after = sorted({k.rsplit("|", 1)[0] for k in after.files if k.count("|") == 2})
+
+    def batches(recording, key):
+        """The scene's batch count (0: not recorded)."""
+        name = key.split("|", 1)[0] + "|batches"
+        return int(recording[name]) if name in recording.files else 0
     missing = sorted(set(keys) - set(keys_after))
     extra = sorted(set(keys_after) - set(keys))
     rows = []
-    n_elements = n_identical = n_exact = 0
+    n_elements = n_identical = n_exact = n_untested = 0
     for key in keys:
         if key in missing:
             continue
@@ -95,13 +108,24 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         finite = np.isfinite(m0) & np.isfinite(m1)
         n_elements += int(finite.sum())
         n_identical += int((finite & (m0 == m1)).sum())
-        se = np.sqrt(np.nan_to_num(s0) ** 2 + np.nan_to_num(s1) ** 2)
+        v0, v1 = np.nan_to_num(s0) ** 2, np.nan_to_num(s1) ** 2
+        se = np.sqrt(v0 + v1)
         exact = finite & (se == 0.0)
         n_exact += int(exact.sum())
         scale = np.maximum(np.abs(m0), np.abs(m1))
         exact_bad = exact & (np.abs(m1 - m0) > 1e-12 * np.maximum(scale, 1e-300))
+        n1 = batches(after, key)
+        n0 = batches(before, key) or n1
+        if 0 < min(n0, n1) < EXACT_MIN_BATCHES:
+            n_untested += int(exact_bad.sum())
+            exact_bad[:] = False
         with np.errstate(divide="ignore", invalid="ignore"):
             z = np.where(finite & (se > 0.0), (m1 - m0) / se, 0.0)
+            if min(n0, n1) >= 2:
+                nu = (v0 + v1) ** 2 / (v0 ** 2 / (n0 - 1) + v1 ** 2 / (n1 - 1))
+                tested = finite & (se > 0.0)
+                z[tested] = np.sign(z[tested]) * stats.norm.isf(
+                    stats.t.sf(np.abs(z[tested]), nu[tested]))
         worst = float(np.max(np.abs(z))) if z.size else 0.0
         if exact_bad.any():
             worst = math.inf
@@ -123,7 +147,8 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         f"- scene quantities compared: {len(rows)} ({len(keys)} before, {len(keys_after)} after;"
         f" missing after: {len(missing)}, new after: {len(extra)})",
         f"- elements compared: {n_elements}; bit-identical: {n_identical}; exact (zero standard "
-        f"error on both sides): {n_exact}",
+        f"error on both sides): {n_exact}; of those, untested (equal batches by chance in a "
+        f"scene of fewer than {EXACT_MIN_BATCHES} batches, values differ): {n_untested}",
         f"- bound: |z| <= {bound:.2f} (Bonferroni, family-wise two-sided alpha {FAMILY_ALPHA} "
         f"over {n_elements} elements)",
         f"- worst |z|: {worst:.3g}; failing quantities: {len(failing)}",
@@ -145,6 +170,7 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         report.write_text(text)
         report.with_suffix(".json").write_text(json.dumps(
             {"elements": n_elements, "identical": n_identical, "exact": n_exact,
+             "untested": n_untested,
              "bound": bound, "worst_z": worst, "missing": missing, "extra": extra,
              "rows": [{"quantity": k, "elements": n, "worst_z": w, "note": note}
                       for k, n, w, note in rows]}, indent=1, default=float))

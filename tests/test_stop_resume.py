@@ -127,6 +127,7 @@ def test_a_huge_run_stops_within_seconds(tmp_path, signal_number):
     stdout, stderr = proc.communicate(timeout=60)
     latency = time.time() - sent
     assert proc.returncode == 130, stderr
+    print(f"exit {latency:.2f} s after {signal.Signals(signal_number).name}")
     assert latency < 3.0, latency
     assert "to go at" in stderr and "Ctrl-C stops it" in stderr     # the long-run notice
     assert "photon/s" in stderr or "photons/s" in stderr              # the progress bar
