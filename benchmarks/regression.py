@@ -78,7 +78,7 @@ def record(out: Path, configs_dir: Path, cases: list[str] | None) -> int:
     finally:
         oceanmc.simulate = real_simulate
     np.savez_compressed(out, **store)
-    print(f"{len(store) // 2} quantities written to {out}")
+    print(f"{sum(k.endswith('|mean') for k in store)} quantities written to {out}")
     return 0
 
 
@@ -100,8 +100,8 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
     for key in keys:
         if key in missing:
             continue
-        m0, s0 = before[f"{key}|mean"], before[f"{key}|stderr"]
-        m1, s1 = after[f"{key}|mean"], after[f"{key}|stderr"]
+        m0, s0, m1, s1 = (np.atleast_1d(recording[f"{key}|{part}"])
+                          for recording in (before, after) for part in ("mean", "stderr"))
         if m0.shape != m1.shape:
             rows.append((key, m0.size, math.inf, "shape changed"))
             continue
@@ -118,7 +118,7 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         n0 = batches(before, key) or n1
         if 0 < min(n0, n1) < EXACT_MIN_BATCHES:
             n_untested += int(exact_bad.sum())
-            exact_bad[:] = False
+            exact_bad = np.zeros_like(exact_bad)
         with np.errstate(divide="ignore", invalid="ignore"):
             z = np.where(finite & (se > 0.0), (m1 - m0) / se, 0.0)
             if min(n0, n1) >= 2:

@@ -76,11 +76,13 @@ def case_chandrasekhar(ctx: Ctx) -> None:
                     continue
                 exact = name == "Lu" and method.startswith("exact nadir")
                 lu = JK.of(r, name)[0]
+                # quick: the crossing cap estimate at w0 0.5 has a 6-6.5% standard error, so a
+                # 6% precision cap failed at 5 of seeds 11-16 on the kernel of 29d7ba3
                 what = ("exact nadir value L(1)" if exact else
                         f"cap average of L(mu) over {edges[-2]:g}-180 deg")
                 ctx.compare(f"{tag}: {name} vs the {what}", lu.value, lu.stderr,
                             float(ref.chandrasekhar_radiance(w0, mu0, 1.0)) if exact else cap_ref,
-                            rel_cap=ctx.pick(0.02, 0.06),
+                            rel_cap=ctx.pick(0.02, 0.1),
                             note=method if name == "Lu" else "crossing estimator")
 
     plt = _plt()
