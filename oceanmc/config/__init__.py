@@ -12,6 +12,9 @@ from .base import Asymmetry, ConfigError, Finite, Fraction, NonNegative, _Strict
 from .bottom import (BlackBottom, Bottom, GGXBottom, HapkeBottom, LambertianBottom,
                      LambertianSpecularBottom, MinnaertBottom, NoBottom, Sampling, SpecularBottom,
                      TableBottom, bottom_has_mirror, bottom_weight_bounded)
+from .components import (CdomComponent, ChlorophyllComponent, Component, ConstantComponent,
+                         GaussianProfile, LinearProfile, ParticlesComponent, Profile,
+                         PureWaterComponent, TableComponent, TableProfile)
 from .estimator import Estimator
 from .illumination import Illumination, SkyMap
 from .loading import _describe, _key_path, _resolve_files, config_to_yaml, load_config
@@ -28,6 +31,9 @@ __all__ = [
     "Isotropic", "Rayleigh", "PureWater", "HenyeyGreenstein", "TwoTermHG", "FournierForand",
     "Petzold", "TablePhase", "BasicPhase", "MixtureComponent", "Mixture", "Phase",
     "Layer", "Water", "WavelengthRange",
+    "GaussianProfile", "LinearProfile", "TableProfile", "Profile", "PureWaterComponent",
+    "ChlorophyllComponent", "CdomComponent", "ParticlesComponent", "TableComponent",
+    "ConstantComponent", "Component",
     "SkyMap", "Illumination",
     "Surface",
     "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",

@@ -23,7 +23,9 @@ import numpy as np
 from tqdm import tqdm
 
 from .. import __version__, scene
+from ..optics import iops_table
 from ..config import SceneConfig, config_to_yaml, load_config
+from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
@@ -51,6 +53,17 @@ def next_budget(budget: int, seconds: float) -> int:
 
 def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h" if seconds < 48 * 3600 else f"{seconds / 86400:.1f} days"
+
+
+def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int) -> np.ndarray:
+    """The budget with the absorption of the sublayers of a depth profile summed into the
+    configured layer they resolve."""
+    if len(config_layer) == n_layers:
+        return budget
+    out = np.zeros(budget.shape[:-1] + (BUDGET_LAYERS + n_layers,))
+    out[..., :BUDGET_LAYERS] = budget[..., :BUDGET_LAYERS]
+    np.add.at(out.T, BUDGET_LAYERS + config_layer, budget[..., BUDGET_LAYERS:].T)
+    return out
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -84,6 +97,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_batches = config.batches - first_batch
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
+    config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
     depths = config.tallies.depths_m
     # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
     # beam (weight per sun packet, direction), scattering events, tally row
@@ -164,11 +178,13 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "scattering_events": int(raw["events"][:done].sum()),
         }
         part = {name: values[:done] for name, values in raw.items()}
+        part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
         result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
                               config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
                               config.tallies.local_directions_deg, sc.local_rows,
                               config.nadir_local)
         result.resume_state = state
+        result.iops = iops_table(sc.layers, config.wavelengths)
         return result
 
     t1 = last_checkpoint = time.perf_counter()

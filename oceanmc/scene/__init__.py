@@ -35,6 +35,7 @@ class Scene:
     estimator: np.ndarray
     angles: Grid
     local_rows: list
+    layers: tuple               # optics.LayerIOPs of each kernel layer
 
     def kernel_args(self) -> tuple:
         return (self.medium, self.mf, self.mi, self.surface, self.bottom, self.bp, self.sky,
@@ -70,10 +71,11 @@ def build(config: cfg.SceneConfig) -> Scene:
     sk, sf = sky.pack(config.illumination)
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]))
+                                   len(directions[0]), len(column.albedo))
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
-                 pack_estimator(config.estimator, column.albedo), angles, local_rows)
+                 pack_estimator(config.estimator, column.albedo), angles, local_rows,
+                 column.layers)
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]

@@ -68,7 +68,7 @@ def theta_lookup(mu: np.ndarray) -> np.ndarray:
 
 
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
+         surface_level: int, n_dirs: int, n_layers: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows."""
     grid = make_grid(config.tallies)
@@ -77,7 +77,7 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     n_levels = n_depths + 2
     radiance_on = bool(config.tallies.radiance)
     theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
-    n_budget = models.BUDGET_LAYERS + len(config.water.layers)
+    n_budget = models.BUDGET_LAYERS + n_layers
     layout = {}
     size = 0
     for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
