@@ -16,7 +16,8 @@ from .components import (CdomComponent, ChlorophyllComponent, Component, Constan
                          GaussianProfile, LinearProfile, ParticlesComponent, Profile,
                          PureWaterComponent, TableComponent, TableProfile)
 from .estimator import Estimator
-from .illumination import Illumination, SkyMap
+from .illumination import (FlatSpectrum, Illumination, SkyMap, Spectrl2Spectrum, Spectrum,
+                           SunPosition, TableSpectrum)
 from .loading import _describe, _key_path, _resolve_files, config_to_yaml, load_config
 from .phase import (BasicPhase, FournierForand, HenyeyGreenstein, Isotropic, Mixture,
                     MixtureComponent, Petzold, Phase, PureWater, Rayleigh, TablePhase, TwoTermHG)
@@ -34,7 +35,8 @@ __all__ = [
     "GaussianProfile", "LinearProfile", "TableProfile", "Profile", "PureWaterComponent",
     "ChlorophyllComponent", "CdomComponent", "ParticlesComponent", "TableComponent",
     "ConstantComponent", "Component",
-    "SkyMap", "Illumination",
+    "SkyMap", "Illumination", "SunPosition", "FlatSpectrum", "Spectrl2Spectrum", "TableSpectrum",
+    "Spectrum",
     "Surface",
     "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",
     "SpecularBottom", "LambertianSpecularBottom", "GGXBottom", "HapkeBottom", "TableBottom",

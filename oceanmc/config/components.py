@@ -17,8 +17,9 @@ Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 
 class GaussianProfile(_Strict):
     """background + integral / (width sqrt(2 pi)) exp(-(z - peak_depth)^2 / (2 width^2)), z the
-    depth below the surface (m); integral is the peak's column amount (e.g. mg/m2 for
-    chlorophyll), also accepted as total_mg_m2."""
+    depth below the surface (m); integral is the whole peak's column amount (e.g. mg/m2 for
+    chlorophyll; the share of a peak near the surface that lies above z = 0 is not in the
+    water), also accepted as total_mg_m2."""
     profile: Literal["gaussian"]
     background: NonNegative
     peak_depth_m: Depth

@@ -146,14 +146,26 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
 def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
     """Table files are relative to the config file's folder; they are checked when the scene is
     built (oceanmc/scene.py), which reports the file and the problem."""
+    def resolve(item) -> None:
+        item.file = str((base_dir / item.file).resolve())
+
     for layer in config.water.layers:
         phases = [c.phase for c in layer.phase.components] \
             if isinstance(layer.phase, Mixture) else [layer.phase]
+        for component in layer.components or ():
+            phases.append(getattr(component, "phase", None))
+            if component.model == "table":
+                resolve(component)
+            for value in component.__dict__.values():
+                if getattr(value, "profile", None) == "table":
+                    resolve(value)
         for phase in phases:
             if isinstance(phase, TablePhase):
-                phase.file = str((base_dir / phase.file).resolve())
+                resolve(phase)
     if isinstance(config.bottom, TableBottom):
         config.bottom.file = str((base_dir / config.bottom.file).resolve())
+    if config.illumination.spectrum.model == "table":
+        resolve(config.illumination.spectrum)
     if isinstance(config.illumination.sky, SkyMap):
         config.illumination.sky.map = str((base_dir / config.illumination.sky.map).resolve())
 

@@ -8,8 +8,8 @@ the kernel's records.
     illumination_spectrum(config) -> (Ed0 (n_wl,), diffuse_fraction (n_wl,), sun_zenith_deg)
 """
 from .column import LayerIOPs, column_iops, iops_table, wavelengths
-from .illumination import illumination_spectrum
+from .illumination import illumination_spectrum, monochromatic_illumination
 from .phases import backscatter_fraction
 
-__all__ = ["wavelengths", "LayerIOPs", "column_iops", "iops_table", "illumination_spectrum",
-           "backscatter_fraction"]
+__all__ = ["wavelengths", "LayerIOPs", "column_iops", "illumination_spectrum",
+           "backscatter_fraction", "monochromatic_illumination", "iops_table"]

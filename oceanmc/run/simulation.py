@@ -23,7 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .. import __version__, scene
-from ..optics import iops_table
+from ..optics import iops_table, monochromatic_illumination
 from ..config import SceneConfig, config_to_yaml, load_config
 from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
@@ -97,6 +97,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_batches = config.batches - first_batch
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
+    ed0 = monochromatic_illumination(config).Ed0
     config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
     depths = config.tallies.depths_m
     # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
@@ -180,7 +181,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         part = {name: values[:done] for name, values in raw.items()}
         part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
         result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
-                              config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
+                              ed0, n_layers, config.tallies.radiance, attrs,
                               config.tallies.local_directions_deg, sc.local_rows,
                               config.nadir_local)
         result.resume_state = state

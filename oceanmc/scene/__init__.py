@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
+from .. import optics
 from ..kernel.records import ESTIMATOR, record
 from . import bottom, estimates, grid, medium, sky, surface
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
@@ -68,7 +69,7 @@ def build(config: cfg.SceneConfig) -> Scene:
     med, mf, mi, column = medium.pack(config)
     surf = surface.pack(config.surface, config.n_water)
     bot, bp = bottom.pack(config.bottom)
-    sk, sf = sky.pack(config.illumination)
+    sk, sf = sky.pack(optics.monochromatic_illumination(config))
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
                                    len(directions[0]), len(column.albedo))
