@@ -68,9 +68,11 @@ def theta_lookup(mu: np.ndarray) -> np.ndarray:
 
 
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int, n_layers: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
+         surface_level: int, n_dirs: int,
+         n_layers: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
-    light), then 0+ (water-leaving light); n_dirs local-estimate rows."""
+    light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
+    (a depth profile's sublayers each absorb into a budget column of their own)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
