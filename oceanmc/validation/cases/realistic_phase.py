@@ -10,7 +10,7 @@ import numpy as np
 from ...scene import phase_tables
 from ..context import Ctx
 from ..stats import JK
-from .common import MU_CUT, Case, scene
+from .common import MU_CUT, Case, _plt, scene
 
 N_MOMENTS = 600
 
@@ -54,7 +54,9 @@ SLABS = [
 def case_realistic_phase(ctx: Ctx) -> None:
     from .. import disort_ref
     photons = ctx.pick(4_000_000, 200_000)
-    for name, phase, table, tau, w0, sun in SLABS:
+    plt = _plt()
+    fig, axes = plt.subplots(1, len(SLABS), figsize=(4.0 * len(SLABS), 3.4))
+    for ax, (name, phase, table, tau, w0, sun) in zip(axes, SLABS):
         thickness = 2.0
         c = tau / thickness
         levels = [0.0, thickness / 2, thickness]
@@ -85,6 +87,17 @@ def case_realistic_phase(ctx: Ctx) -> None:
         ctx.compare_jk(f"{name}: Eu", JK.of(r, "Eu")[eu_at], d1["Eu"][eu_at],
                        ref_error=np.abs(d1["Eu"] - d2["Eu"])[eu_at],
                        labels=[labels[i] for i in eu_at], rel_cap=ctx.pick(0.01, 0.05))
+        for key, marker in (("Ed", "o"), ("Eu", "s")):
+            ax.errorbar(levels, r[key], yerr=r.stderr(key), fmt=marker, ms=4,
+                        label=f"MC {key}")
+            ax.plot(levels, d1[key], "-", lw=1, label=f"DISORT {key}")
+        ax.set_yscale("log")
+        ax.set_title(name, fontsize=8)
+        ax.set_xlabel("depth (m)", fontsize=8)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    ctx.figure(fig, "fluxes", "Ed and Eu against depth in each slab: MC (points, with standard "
+               "errors) and DISORT with the phase function's Legendre moments (lines).")
     ctx.note("Slabs 2 m thick without a refractive interface (surface: none) over a black "
              "bottom, sun only, with the phase functions users run: Petzold's average particle "
              "(the kernel's table), Fournier-Forand (bb/b = 0.01, the kernel's table) and pure "
