@@ -180,13 +180,13 @@ class Ctx:
             out.append(self._add(Check(
                 self.case, f"{quantity} {what}",
                 float(np.sum(z[np.isfinite(z)] ** 2) / n), None,
-                1.0, cz, MIN_Z_TOL, bool(finite and cz <= MIN_Z_TOL and cap_ok),
+                (nb - 1) / (nb - 3.0), cz, MIN_Z_TOL, bool(finite and cz <= MIN_Z_TOL and cap_ok),
                 "chi2", grp, 0.0, float(np.nanmax(np.abs(rel_err))) if np.any(np.isfinite(
                     rel_err)) else None, med, rel_cap,
-                ("value: mean z^2; reference: 1; z: Hotelling's T^2 with the batch covariance "
-                 "as a one-sided normal z" if hz is not None else
-                 "value: mean z^2; reference: 1; z: the chi-square of the members' normal "
-                 "equivalents as a one-sided normal z") + "; rel_stderr: median over the group"
+                ("value: mean z^2; reference: its expectation for Student-t z; z: Hotelling's "
+                 "T^2 with the batch covariance as a one-sided normal z" if hz is not None else
+                 "value: mean z^2; reference: its expectation for Student-t z; z: the "
+                 "chi-square of the members' normal equivalents as a one-sided normal z") + "; rel_stderr: median over the group"
                 + (f"; {note}" if note else ""), None, bool(finite and cap_ok))))
         return out
 
