@@ -186,7 +186,8 @@ class Ctx:
                 ("value: mean z^2; reference: its expectation for Student-t z; z: Hotelling's "
                  "T^2 with the batch covariance as a one-sided normal z" if hz is not None else
                  "value: mean z^2; reference: its expectation for Student-t z; z: the "
-                 "chi-square of the members' normal equivalents as a one-sided normal z") + "; rel_stderr: median over the group"
+                 "chi-square of the members' normal equivalents as a one-sided normal z")
+                + "; rel_stderr: median over the group"
                 + (f"; {note}" if note else ""), None, bool(finite and cap_ok))))
         return out
 
