@@ -120,10 +120,11 @@ class Ctx:
                 n_batches: int | None = None, note: str = "", counts=None,
                 min_count: float = 10.0, loo=None) -> list[Check]:
         """z-score checks of estimates against references. A single quantity must have
-        |z| <= 4 (and stderr/|reference| <= rel_cap when given). A group of N quantities uses the
-        Bonferroni-corrected Student-t bound for each member, and gets a summary record: the
-        standardised sum of z^2 (one-sided, <= 4) with the median relative standard error, which
-        must not exceed rel_cap. With the members' leave-one-batch-out replicates (loo, batch
+        |z| within its bound (and stderr/|reference| <= rel_cap when given). A group of N
+        quantities gets a bound for each member and a summary record: the chi-square of the
+        members' z as a one-sided normal z, with the median relative standard error, which must
+        not exceed rel_cap. The bounds set here are the group's own (Bonferroni over its members);
+        finalize() then sets them for the whole case. With the members' leave-one-batch-out replicates (loo, batch
         axis first) and few enough members, the summary is Hotelling's T^2 with their estimated
         covariance instead (members of one run, e.g. depths, are correlated). counts (optional):
         the expected number of photons per batch that score each member; members below
