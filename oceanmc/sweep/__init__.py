@@ -14,7 +14,7 @@ import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from .axes import SweepError, SweepSpec, load_sweep, set_key_path
 from .dataset import PointStore, Summary, assemble, write_dataset
@@ -87,7 +87,7 @@ def run(plan: Plan, client, threads: int | None = None, progress: bool = False) 
 def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None, *,
           workers: int | None = None, scheduler: str | None = None, client=None,
           threads: int | None = None, batch_groups: int | None = None,
-          progress: bool = False):
+          progress: bool = False, log: Callable[[str], None] | None = None):
     """Runs a sweep and returns its xarray Dataset (written to `output`, a .nc file, if given).
 
     source: a sweep YAML file or a mapping {base: scene file | scene mapping | SceneConfig,
@@ -97,25 +97,40 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     per core), `threads` threads each (default: the cores shared among the local workers).
     Finished points are kept in `<output stem>.points/` (a temporary folder without output):
     a rerun skips them. A KeyboardInterrupt writes the points done so far (status `pending`
-    for the rest) and is raised again."""
+    for the rest) and is raised again. log(text) receives a line on what is about to run."""
     import os
 
     with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:
         folder = points_folder(Path(output)) if output is not None else Path(scratch)
         plan = prepare(source, folder, batch_groups)
-        if threads is None and client is None and scheduler is None:
-            threads = max(1, (os.cpu_count() or 1) // (workers or os.cpu_count() or 1))
-        from .execute import dask_client
-        try:
-            if plan.todo:
-                with dask_client(workers, scheduler, client) as dask:
-                    run(plan, dask, threads, progress)
-        finally:
+        local = client is None and scheduler is None
+        if local:
+            workers = workers or os.cpu_count() or 1
+            if threads is None:
+                threads = max(1, (os.cpu_count() or 1) // workers)
+        todo = len(plan.todo)
+        if log is not None:
+            where = f"a local cluster of {workers} worker process(es), {threads} thread(s) " \
+                    "each" if local else \
+                f"the Dask scheduler at {scheduler or client.scheduler.address}"
+            log(f"{len(plan.points)} points ({' x '.join(map(str, plan.spec.shape)) or '1'}): "
+                f"{len(plan.points) - todo} finished earlier, {todo} to run on {where}")
+
+        def finish():
             dataset = plan.dataset()
             if output is not None:
                 write_dataset(dataset, Path(output))
-    return dataset
+            return dataset
 
+        if not todo:
+            return finish()
+        from .execute import dask_client
+        with dask_client(workers, scheduler, client) as dask:
+            try:
+                run(plan, dask, threads, progress)
+            finally:   # also on Ctrl-C: the points done so far, before the cluster closes
+                dataset = finish()
+    return dataset
 
 class _CallableModule(type(tempfile)):
     """`oceanmc.sweep` is both this package and the function: importing a submodule makes the
