@@ -251,7 +251,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     try:
         lut = sweep(source, out, workers=args.workers, scheduler=args.scheduler,
                     threads=args.threads, batch_groups=args.batch_groups,
-                    progress=not args.quiet,
+                    workers_write=True if args.workers_write else None, progress=not args.quiet,
                     log=lambda text: print(f"oceanmc: sweep: {text}", file=sys.stderr,
                                            flush=True))
     except SweepError as exc:
@@ -290,6 +290,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
 
+    if args.sweep:
+        from .bench import sweep
+        return sweep.main(Path(args.output), quick=args.quick)
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -356,6 +359,9 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--batch-groups", type=_positive_int, metavar="N",
                        help="spread each point's batches over N tasks (merged exactly; "
                             "overrides the sweep file's batch_groups)")
+    sweep.add_argument("--workers-write", action="store_true",
+                       help="with --scheduler: the workers see the output folder (a shared file "
+                            "system) and write each point's file themselves")
     sweep.add_argument("--overwrite", action="store_true",
                        help="replace an output file that is not an oceanmc sweep dataset")
     sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -372,6 +378,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("-o", "--output", default="benchmarks", metavar="DIR",
                        help="report folder (default: benchmarks)")
     bench.add_argument("--quick", action="store_true", help="small counts: a smoke test")
+    bench.add_argument("--sweep", action="store_true",
+                       help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
+                            "and 2 Dask workers against a plain loop")
     bench.add_argument("--configs", default="configs", metavar="DIR",
                        help="folder with the benchmark scenes (default: configs)")
     bench.add_argument("--bare-walk", metavar="PATH",

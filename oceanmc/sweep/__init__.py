@@ -67,9 +67,11 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
     return plan
 
 
-def run(plan: Plan, client, threads: int | None = None, progress: bool = False) -> None:
+def run(plan: Plan, client, threads: int | None = None, progress: bool = False,
+        workers_write: bool = False) -> None:
     """Runs the points not yet done on the client's cluster; each finished point is stored as it
-    arrives (a KeyboardInterrupt leaves the plan with what is done)."""
+    arrives (a KeyboardInterrupt leaves the plan with what is done). workers_write: the workers
+    see the output folder and write the points' results files themselves."""
     from .execute import run_points
 
     def on_done(point: Point, summary: Summary | None, error: str | None) -> None:
@@ -81,13 +83,14 @@ def run(plan: Plan, client, threads: int | None = None, progress: bool = False) 
     todo = plan.todo
     if todo:
         run_points(client, plan.store, todo, plan.spec.batch_groups, threads, on_done, progress,
-                   len(plan.points), len(plan.points) - len(todo))
+                   len(plan.points), len(plan.points) - len(todo), workers_write)
 
 
 def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None, *,
           workers: int | None = None, scheduler: str | None = None, client=None,
           threads: int | None = None, batch_groups: int | None = None,
-          progress: bool = False, log: Callable[[str], None] | None = None):
+          workers_write: bool | None = None, progress: bool = False,
+          log: Callable[[str], None] | None = None):
     """Runs a sweep and returns its xarray Dataset (written to `output`, a .nc file, if given).
 
     source: a sweep YAML file or a mapping {base: scene file | scene mapping | SceneConfig,
@@ -96,7 +99,9 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     `scheduler` (tcp://HOST:PORT), or on a local cluster of `workers` processes (default: one
     per core), `threads` threads each (default: the cores shared among the local workers).
     Finished points are kept in `<output stem>.points/` (a temporary folder without output):
-    a rerun skips them. A KeyboardInterrupt writes the points done so far (status `pending`
+    a rerun skips them. workers_write: the workers write the points' files there themselves
+    (they must see that folder: a shared file system; default: only on the local cluster
+    started here), else they send each Result back to be written here. A KeyboardInterrupt writes the points done so far (status `pending`
     for the rest) and is raised again. log(text) receives a line on what is about to run."""
     import os
 
@@ -127,7 +132,8 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
         from .execute import dask_client
         with dask_client(workers, scheduler, client) as dask:
             try:
-                run(plan, dask, threads, progress)
+                run(plan, dask, threads, progress,
+                    workers_write=local if workers_write is None else workers_write)
             finally:   # also on Ctrl-C: the points done so far, before the cluster closes
                 dataset = finish()
     return dataset

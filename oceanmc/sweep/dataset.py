@@ -51,7 +51,7 @@ class PointStore:
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
 
-    def _path(self, point: Point, batches: tuple[int, int] | None = None) -> Path:
+    def path(self, point: Point, batches: tuple[int, int] | None = None) -> Path:
         if batches is None:
             return self.folder / f"{point.key}.h5"
         return self.folder / f"{point.key}.batches-{batches[0]}-{batches[1]}.h5"
@@ -69,31 +69,31 @@ class PointStore:
         return result
 
     def finished(self, point: Point) -> Summary | None:
-        result = self._load(self._path(point), point.yaml)
+        result = self._load(self.path(point), point.yaml)
         return None if result is None else Summary.of(result)
 
     def part_done(self, point: Point, batches: tuple[int, int]) -> bool:
-        return self._load(self._path(point, batches), point.part_yaml(*batches)) is not None
+        return self._load(self.path(point, batches), point.part_yaml(*batches)) is not None
 
     def save(self, point: Point, result: Result) -> Summary:
-        result.save(self._path(point))
+        result.save(self.path(point))
         return Summary.of(result)
 
     def save_part(self, point: Point, batches: tuple[int, int], result: Result) -> None:
-        result.save(self._path(point, batches))
+        result.save(self.path(point, batches))
 
     def merge_parts(self, point: Point, ranges: list[tuple[int, int]]) -> Summary:
         """The point's Result from its batch groups: their batches concatenated in order, which
         is the Result of one run of all of them (same batches, same means, same errors)."""
         parts = []
         for batches in ranges:
-            part = self._load(self._path(point, batches), point.part_yaml(*batches))
+            part = self._load(self.path(point, batches), point.part_yaml(*batches))
             part.attrs["config_yaml"] = point.yaml   # the same batches of the point's scene
             parts.append(part)
         result = merge_results(parts, resume=True) if len(parts) > 1 else parts[0]
         summary = self.save(point, result)
         for batches in ranges:
-            self._path(point, batches).unlink(missing_ok=True)
+            self.path(point, batches).unlink(missing_ok=True)
         return summary
 
 
