@@ -43,6 +43,13 @@ class Plan:
         return [p for p in self.points if p.key not in self.summaries]
 
     def dataset(self):
+        """The dataset of the points done, the store's folder being the record: a worker may
+        have written a point's file before its answer reached this process (a Ctrl-C then)."""
+        for point in self.todo:
+            if point.key not in self.errors:
+                summary = self.store.finished(point)
+                if summary is not None:
+                    self.summaries[point.key] = summary
         return assemble(self.spec, self.points, self.summaries, self.errors)
 
 
