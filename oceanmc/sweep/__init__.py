@@ -108,8 +108,9 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     Finished points are kept in `<output stem>.points/` (a temporary folder without output):
     a rerun skips them. workers_write: the workers write the points' files there themselves
     (they must see that folder: a shared file system; default: only on the local cluster
-    started here), else they send each Result back to be written here. A KeyboardInterrupt writes the points done so far (status `pending`
-    for the rest) and is raised again. log(text) receives a line on what is about to run."""
+    started here), else they send each Result back to be written here. A KeyboardInterrupt
+    writes the points done so far (status `pending` for the rest) and is raised again.
+    log(text) receives a line on what is about to run."""
     import os
 
     with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:

@@ -2,15 +2,15 @@
 
 Each task runs one point, or one group of a point's batches, with simulate() in a worker. On a
 local cluster the worker writes the point's results file into the store's folder itself (the
-writing, 50 ms a point, then runs in parallel) and hands back the estimates; on another
+writing, 17-50 ms a point, then runs in parallel) and hands back the estimates; on another
 scheduler it hands back the Result and this process stores it (dataset.PointStore), so remote
-workers need no access to the output folder. The kernel is compiled (or loaded) here before the points are
-checked, which fills the on-disk cache the workers of a local cluster then load from (0.3 s
-instead of a 10-14 s compilation each); every worker loads it once before its first point.
+workers need no access to the output folder. The kernel is compiled (or loaded) here before the
+points are checked, which fills the on-disk cache the workers of a local cluster then load from
+(0.3 s instead of a 10-14 s compilation each); every worker loads it once before its first point.
 
 Dask reschedules the tasks of a worker that dies (a lost worker's points run elsewhere; after
-`distributed.scheduler.allowed-failures` + 1 deaths with the same task, 3 by default, that point
-is recorded as failed). A point whose task raises is recorded with its error and the others go
+`distributed.scheduler.allowed-failures` + 1 deaths with the same task, 4 by default, that
+point is recorded as failed). A point whose task raises is recorded with its error and the others go
 on. Ctrl-C (KeyboardInterrupt) cancels what is left; the caller then writes what is done.
 """
 from __future__ import annotations
@@ -102,9 +102,9 @@ def run_points(client, store: PointStore, todo: list[Point], groups: int, thread
                 continue
             save_to = str(store.path(point, None if len(ranges) == 1 else (first, end))) \
                 if workers_write else None
+            key = f"oceanmc-point-{point.key}-{first}-{uuid.uuid4().hex}"
             future = client.submit(run_part, point.part_yaml(first, end), first, threads,
-                                   save_to, key=f"oceanmc-point-{point.key}-{first}-{uuid.uuid4().hex}",
-                                   pure=False)
+                                   save_to, key=key, pure=False)
             task_of[future] = (point, (first, end))
             remaining[point.key].add((first, end))
     failed: dict[str, str] = {}
