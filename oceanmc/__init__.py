@@ -22,10 +22,10 @@ _LAZY = {
     "Result": "run.results",
     "load_result": "run.hdf5",
     "simulate": "run.simulation",
+    "sweep": "sweeps",
 }
-# the subpackages, as attributes (the data flow: config -> scene -> kernel -> run); `sweep` is
-# also the function oceanmc.sweep(...) (the package is callable, see sweep/__init__.py)
-_SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run", "sweep"})
+# the subpackages, as attributes (the data flow: config -> scene -> kernel -> run -> sweeps)
+_SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run", "sweeps"})
 
 __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result", "simulate",
            "sweep", "__version__"]
@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from .run.hdf5 import load_result
     from .run.results import Result
     from .run.simulation import simulate
+    from .sweeps import sweep
 
 
 def __getattr__(name: str):

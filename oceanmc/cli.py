@@ -236,7 +236,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from .sweep import SweepError, sweep
+    from .sweeps import SweepError, sweep
 
     source = Path(args.sweep)
     out = Path(args.output) if args.output else Path("results") / f"{source.stem}.nc"

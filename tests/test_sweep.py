@@ -18,9 +18,9 @@ import yaml
 
 import oceanmc
 from conftest import REPO
-from oceanmc.sweep import SweepError, load_sweep, set_key_path
-from oceanmc.sweep.dataset import variable_name
-from oceanmc.sweep.points import build_points
+from oceanmc.sweeps import SweepError, load_sweep, set_key_path
+from oceanmc.sweeps.dataset import variable_name
+from oceanmc.sweeps.points import build_points
 
 ENV = dict(os.environ, PYTHONPATH=str(REPO))
 PYTHON_BIN = Path(sys.executable).parent

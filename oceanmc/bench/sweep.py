@@ -45,8 +45,8 @@ def main(out_dir: Path, quick: bool = False) -> int:
     from distributed import Client, LocalCluster
 
     from .. import __version__, simulate, sweep
-    from ..sweep import load_sweep
-    from ..sweep.points import build_points
+    from ..sweeps import load_sweep
+    from ..sweeps.points import build_points
 
     photons = 4000 if quick else 100_000
     spec = lut_sweep(photons)

@@ -10,7 +10,6 @@ Dask cluster), dataset.py (per-point results files and the assembled dataset).
 """
 from __future__ import annotations
 
-import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -145,14 +144,3 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
             finally:   # also on Ctrl-C: the points done so far, before the cluster closes
                 dataset = finish()
     return dataset
-
-class _CallableModule(type(tempfile)):
-    """`oceanmc.sweep` is both this package and the function: importing a submodule makes the
-    package an attribute of `oceanmc`, which would hide the function, so the package itself can
-    be called: oceanmc.sweep(...) is sweep(...)."""
-
-    def __call__(self, *args, **kwargs):
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
