@@ -117,3 +117,30 @@ def test_all_configs_are_checked_before_any_runs(tmp_path, small_scene):
     assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
     assert "missing.h5" in done.stderr
     assert not (tmp_path / "out" / "good.h5").exists()
+
+
+# --- extreme but finite numbers: refused with one line, or computed without cancelling -----
+
+@pytest.mark.parametrize("change", [
+    lambda s: s["water"]["layers"][0].update(a=1e308, b=1e308),
+    lambda s: s["water"]["layers"][0].update(thickness_m=1e308),
+    lambda s: s["illumination"].update(Ed0=1e308),
+    lambda s: s.update(estimator={"max_events": 10**400}),
+    lambda s: s.update(estimator={"upward_fraction": 0.1, "upward_cone_deg": 1e-6}),
+])
+def test_huge_or_tiny_values_are_refused(small_scene, change):
+    change(small_scene)
+    refused(small_scene, "config: ")
+
+
+def test_small_upward_cone_density_does_not_cancel(small_scene):
+    import math
+    from oceanmc import scene
+    small_scene["estimator"] = {"upward_fraction": 0.1, "upward_cone_deg": 0.01}
+    config = load_config(small_scene)
+    built = scene.build(config)
+    cone = math.radians(0.01)
+    # 2 pi (1 - cos A) by its series 2 pi (A^2/2 - A^4/24), exact to 1e-20 relative here
+    solid_angle = 2.0 * math.pi * (cone ** 2 / 2.0 - cone ** 4 / 24.0)
+    density = built.mf[int(built.medium["up_density"][0])]
+    assert abs(density / (0.1 / solid_angle) - 1.0) < 1e-12
