@@ -144,3 +144,18 @@ def test_small_upward_cone_density_does_not_cancel(small_scene):
     solid_angle = 2.0 * math.pi * (cone ** 2 / 2.0 - cone ** 4 / 24.0)
     density = built.mf[int(built.medium["up_density"][0])]
     assert abs(density / (0.1 / solid_angle) - 1.0) < 1e-12
+
+
+def test_results_with_more_than_4100_layers_can_be_saved(tmp_path):
+    # one budget/absorbed_layer_N per layer, each attached to the batch dimension scale: the
+    # scale's reference list outgrew HDF5's 64 KB compact attribute limit at ~4,100 layers
+    import numpy as np
+    from oceanmc.run.hdf5 import COORD_UNITS, load_result
+    from oceanmc.run.results import Quantity, Result
+    names = [f"budget/absorbed_layer_{i + 1}" for i in range(4200)]
+    quantities = {name: Quantity(name, (), np.full(2, 0.5), "1", "absorbed") for name in names}
+    coords = {name: np.zeros(0) for name in COORD_UNITS if name != "batch"}
+    Result(coords, quantities, {"photons": 4}).save(tmp_path / "many.h5")
+    back = load_result(tmp_path / "many.h5")
+    assert len(back.quantities) == 4200
+    assert back.quantities[names[-1]].batches.tolist() == [0.5, 0.5]
