@@ -11,7 +11,7 @@ from pydantic import Field, field_validator, model_validator
 from .base import Coefficient, _Strict
 from .components import Component
 from .phase import Isotropic, Mixture, Phase
-from .wavelengths import BackscatterRatio, Spectral, spectral
+from .wavelengths import BackscatterRatio, spectral
 
 
 def values(value: float | list[float]) -> list[float]:
