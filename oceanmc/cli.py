@@ -31,6 +31,8 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
         if len(configs) > 1:
             raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
         return [target]
+    if len(configs) == 1 and not target.is_dir() and not out.endswith(("/", os.sep)):
+        return [target.with_name(target.name + ".h5")]  # `-o name` means the file name.h5
     return [target / f"{c.stem}.h5" for c in configs]
 
 
@@ -92,6 +94,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .run.results import MergeError, format_summary, merge_results
     from .run.compiling import CompileInterrupted
     from .run.simulation import simulate
+    from . import scene
 
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
@@ -103,8 +106,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     for path, out in zip(configs, outputs):
         try:
             config = load_config(path, overrides)
+            scene.build(config)  # reads its data files: every scene is checked before any runs
         except ConfigError as exc:
-            print(f"oceanmc: config error: {exc}", file=sys.stderr)
+            print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
+                  else f"oceanmc: config error: {exc}", file=sys.stderr)
             return 2
         _check_writable(out, args.overwrite or (args.resume and out.exists()),
                         _file_size_estimate(config))
@@ -164,7 +169,9 @@ def cmd_run(args: argparse.Namespace) -> int:
                 f"; {len(unfinished['batch'])} more begun, kept to be continued"
             print(f"  PARTIAL: {done} of {total} batches whole ({result.attrs['photons']:,} "
                   f"photons; the estimates use whole batches only){begun}; continue with: "
-                  f"oceanmc run {path} -o {out} --resume")
+                  f"oceanmc run {path} -o {out} --resume"
+                  + "".join(f" --{key} {value}" for key, value in overrides.items()
+                            if value is not None))
             if done == 0:
                 print("  no batch is whole yet: the file holds no estimate, only the state to "
                       "resume from")
@@ -410,7 +417,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _positive_int(text: str) -> int:
     try:
         value = int(float(text)) if "e" in text.lower() else int(text)
-    except ValueError:
+    except (ValueError, OverflowError):  # OverflowError: 1e400, inf
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")

@@ -16,5 +16,8 @@ class _Strict(BaseModel):
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+# Absorption and scattering coefficients: the most turbid natural waters reach ~1e3 1/m; larger
+# finite values (1e308) would overflow a + b and the optical depths.
+Coefficient = Annotated[float, Field(ge=0.0, le=1e6, allow_inf_nan=False)]
 Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
 Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)]

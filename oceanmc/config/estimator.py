@@ -21,8 +21,10 @@ class Estimator(_Strict):
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
-    max_events: Annotated[int, Field(ge=100)] = 1_000_000
+    max_events: Annotated[int, Field(ge=100, le=10**12)] = 1_000_000
     split_weight: Optional[Annotated[float, Field(gt=1.0, allow_inf_nan=False)]] = None
     # scattering biased toward straight up (kernel/upward.py): off (null) by default
     upward_fraction: Optional[Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)]] = None
-    upward_cone_deg: Annotated[float, Field(gt=0.0, le=90.0, allow_inf_nan=False)] = 15.0
+    # at least 0.01 deg: the kernel draws cos psi = 1 - u (1 - cos A), whose 1 - cos A is
+    # accurate to 1e-8 relative there and loses all accuracy near 1e-6 deg
+    upward_cone_deg: Annotated[float, Field(ge=0.01, le=90.0, allow_inf_nan=False)] = 15.0

@@ -83,7 +83,8 @@ class Illumination(_Strict):
     """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
     Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
     sun_zenith_deg); or {map: FILE} (sky_maps.py)."""
-    Ed0: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 1.0
+    # bounded so that Ed0 times any tally (tallies hold up to ~1e6 x Ed0) stays finite
+    Ed0: Annotated[float, Field(gt=0.0, le=1e100, allow_inf_nan=False)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
     sky: Annotated[Union[Annotated[Literal["uniform", "cardioidal", "overcast",

@@ -2,6 +2,9 @@
 writing it back as YAML."""
 from __future__ import annotations
 
+import difflib
+import os
+import stat
 import types
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
@@ -53,6 +56,95 @@ def _union_tags(root: type[BaseModel]) -> frozenset[str]:
 _UNION_TAGS = _union_tags(SceneConfig)
 
 
+MAX_CONFIG_BYTES = 1 << 20  # a scene is a few KB; the limit stops /dev/zero and the like
+MAX_YAML_NODES = 100_000   # after aliases are expanded: stops "billion laughs" alias bombs
+
+
+class _SceneLoader(yaml.SafeLoader):
+    """yaml.SafeLoader that refuses a key given twice in one mapping (the second would silently
+    win) and documents whose aliases expand to more than MAX_YAML_NODES nodes."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, (str, int, float, bool)) and key in seen:
+                mark = key_node.start_mark
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"key {key!r} given twice", mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+def _expanded_size(node: yaml.Node) -> int:
+    """Nodes in the document with every alias expanded, computed on the composed graph (where
+    an alias is a shared node) without expanding it."""
+    sizes: dict[int, int] = {}
+
+    def size(n: yaml.Node) -> int:
+        if id(n) in sizes:
+            return sizes[id(n)]
+        sizes[id(n)] = MAX_YAML_NODES + 1  # a recursive alias counts as too many
+        if isinstance(n, yaml.SequenceNode):
+            total = 1 + sum(size(child) for child in n.value)
+        elif isinstance(n, yaml.MappingNode):
+            total = 1 + sum(size(k) + size(v) for k, v in n.value)
+        else:
+            total = 1
+        sizes[id(n)] = min(total, MAX_YAML_NODES + 1)
+        return sizes[id(n)]
+    return size(node)
+
+
+def _read_config_text(path: Path, origin: str) -> str:
+    """The file's text: a regular file of at most MAX_CONFIG_BYTES (a FIFO or a device would
+    block or never end)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except FileNotFoundError:
+        raise ConfigError(f"{origin}: no such file") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise ConfigError(f"{origin}: cannot read it ({getattr(exc, 'strerror', None) or exc})"
+                          ) from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise ConfigError(f"{origin}: not a regular file")
+    with os.fdopen(fd, "rb") as file:
+        data = file.read(MAX_CONFIG_BYTES + 1)
+    if len(data) > MAX_CONFIG_BYTES:
+        raise ConfigError(f"{origin}: larger than {MAX_CONFIG_BYTES // 1024} KB; a scene "
+                          "config is a few KB of YAML")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{origin}: not UTF-8 text ({exc.reason} at byte {exc.start})"
+                          ) from None
+
+
+def _parse_yaml(text: str, origin: str) -> Any:
+    try:
+        loader = _SceneLoader(text)
+        try:
+            node = loader.get_single_node()
+            if node is None:
+                return None
+            if _expanded_size(node) > MAX_YAML_NODES:
+                raise ConfigError(f"{origin}: its aliases expand to more than "
+                                  f"{MAX_YAML_NODES:,} values; a scene needs a few dozen")
+            return loader.construct_document(node)
+        finally:
+            loader.dispose()
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        what = exc.problem or exc.context or "invalid"
+        raise ConfigError(f"{origin}: not valid YAML: {where}{what}") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{origin}: not valid YAML: {str(exc).splitlines()[0]}") from None
+    except RecursionError:
+        raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
+
+
 def _key_path(loc: tuple) -> str:
     path = ""
     for part in loc:
@@ -65,6 +157,40 @@ def _key_path(loc: tuple) -> str:
     return path or "(top level)"
 
 
+def _suggestion(loc: tuple) -> str:
+    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close."""
+    model: Any = SceneConfig
+    for part in loc[:-1]:
+        if isinstance(part, int) or part in _UNION_TAGS:
+            continue
+        field = getattr(model, "model_fields", {}).get(part)
+        if field is None:
+            return " (check its spelling and level)"
+        model = _model_of(field.annotation, loc)
+    names = list(getattr(model, "model_fields", {}))
+    close = difflib.get_close_matches(str(loc[-1]), names, n=1, cutoff=0.6)
+    return f"; did you mean {close[0]}?" if close else " (check its spelling and level)"
+
+
+def _model_of(annotation: Any, loc: tuple) -> Any:
+    """The model class a field holds (through lists, Annotated and unions: the member whose
+    `model` tag is in the error's location, else the only model)."""
+    candidates: list[type[BaseModel]] = []
+
+    def visit(tp: Any) -> None:
+        if isinstance(tp, type) and issubclass(tp, BaseModel):
+            candidates.append(tp)
+        for arg in get_args(tp):
+            visit(arg)
+    visit(annotation)
+    for candidate in candidates:
+        field = candidate.model_fields.get("model")
+        if field is not None and get_origin(field.annotation) is Literal and \
+                set(get_args(field.annotation)) & set(loc):
+            return candidate
+    return candidates[0] if len(candidates) == 1 else None
+
+
 def _describe(error: dict) -> str:
     path = _key_path(tuple(error.get("loc", ())))
     kind = error.get("type", "")
@@ -73,7 +199,7 @@ def _describe(error: dict) -> str:
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     if kind == "extra_forbidden":
-        return f"{path}: unknown key (check its spelling and level)"
+        return f"{path}: unknown key{_suggestion(error.get('loc', ()))}"
     if kind == "missing":
         return f"{path}: required key is missing"
     key = str(ctx.get("discriminator", "model")).strip("'")   # model, or a profile's profile
@@ -102,19 +228,7 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
     if isinstance(source, (str, Path)):
         path = Path(source)
         origin = str(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise ConfigError(f"{origin}: no such file") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ConfigError(f"{origin}: cannot read it ({exc})") from None
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            raise ConfigError(f"{origin}: not valid YAML ({str(exc).splitlines()[0]} "
-                              f"{getattr(exc, 'problem_mark', '') or ''})".strip()) from None
-        except RecursionError:
-            raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
+        data = _parse_yaml(_read_config_text(path, origin), origin)
         base_dir = path.parent
     elif isinstance(source, dict):
         data = source
@@ -136,6 +250,11 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
     except ValidationError as exc:
         errors = exc.errors()
         first = _describe(errors[0])
+        blamed = [key for key, value in (overrides or {}).items()
+                  if value is not None and (first.startswith(f"{key} ")
+                                            or first.startswith(f"{key}:"))]
+        if blamed:  # the value came from the command line, not from the file
+            origin = f"--{blamed[0]} (with {origin})"
         more = f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})" \
             if len(errors) > 1 else ""
         raise ConfigError(f"{origin}: {first}{more}") from None

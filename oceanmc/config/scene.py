@@ -34,6 +34,34 @@ class SceneConfig(_Strict):
     def _increasing(cls, value: Wavelengths | None) -> Wavelengths | None:
         return check_increasing(value)
 
+    @field_validator("name")
+    @classmethod
+    def _printable_name(cls, name: str) -> str:
+        # The name is printed to the terminal and stored as an HDF5 (UTF-8) string: a NUL byte
+        # or a lone surrogate cannot be stored, an escape sequence would reach the terminal.
+        if len(name) > 200:
+            raise ValueError(f"{len(name)} characters; allowed: at most 200")
+        for char in name:
+            if not char.isprintable() or 0xD800 <= ord(char) <= 0xDFFF:
+                raise ValueError(f"contains the character {char!r}; allowed: printable text "
+                                 "(no control characters)")
+        return name
+
+    @field_validator("photons", mode="before")
+    @classmethod
+    def _photons_in_e_notation(cls, value):
+        # YAML 1.1 reads 1e6 (no decimal point) as a string; accept it as --photons does.
+        if isinstance(value, str):
+            try:
+                number = float(value)
+            except ValueError:
+                return value
+            if math.isfinite(number) and number == int(number):
+                return int(number)
+        elif isinstance(value, float) and math.isfinite(value) and value == int(value):
+            return int(value)
+        return value
+
     @model_validator(mode="after")
     def _consistent(self) -> "SceneConfig":
         deep = math.isinf(self.water.layers[-1].thickness_m)

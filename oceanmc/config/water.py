@@ -8,10 +8,10 @@ from typing import Annotated
 
 from pydantic import Field, field_validator, model_validator
 
-from .base import _Strict
+from .base import Coefficient, _Strict
 from .components import Component
 from .phase import Isotropic, Mixture, Phase
-from .wavelengths import BackscatterRatio, Spectral, spectral
+from .wavelengths import BackscatterRatio, spectral
 
 
 def values(value: float | list[float]) -> list[float]:
@@ -19,10 +19,14 @@ def values(value: float | list[float]) -> list[float]:
     return list(value) if isinstance(value, list) else [value]
 
 
+# Larger finite values only overflow optical depths (c x thickness) without meaning anything.
+MAX_THICKNESS_M = 1e6
+
+
 class Layer(_Strict):
     thickness_m: Annotated[float, Field(gt=0.0)]
-    a: Spectral | None = None
-    b: Spectral | None = None
+    a: spectral(Coefficient) | None = None
+    b: spectral(Coefficient) | None = None
     phase: Phase | None = None         # isotropic unless bb_ratio is given
     bb_ratio: spectral(BackscatterRatio) | None = None
     components: Annotated[list[Component], Field(min_length=1, max_length=32)] | None = None
@@ -30,8 +34,9 @@ class Layer(_Strict):
     @field_validator("thickness_m")
     @classmethod
     def _no_nan(cls, v: float) -> float:
-        if math.isnan(v):
-            raise ValueError("must be a positive number or .inf, got nan")
+        if math.isnan(v) or (math.isfinite(v) and v > MAX_THICKNESS_M):
+            raise ValueError(f"must be a positive number up to {MAX_THICKNESS_M:g} m (deeper "
+                             "than any ocean) or .inf")
         return v
 
     @model_validator(mode="after")

@@ -31,7 +31,9 @@ Numba's on-disk cache checks only the source file of each cached function, not t
 functions it calls, so an edit to (say) tally.py would leave transport's cached machine code
 stale. The cache therefore lives in a folder named after a hash of every kernel source file:
 any kernel edit starts a fresh cache. OCEANMC_CACHE_DIR moves it (the benchmark points it at an
-empty folder to time a cold start). Numba reads its CACHE_DIR when a function is decorated, so
+empty folder to time a cold start). Caches of earlier kernel sources are deleted, but only
+folders that hold oceanmc's marker file: OCEANMC_CACHE_DIR may name a folder that also holds a
+user's own numba-* folders. Numba reads its CACHE_DIR when a function is decorated, so
 the decorators here set it for the kernel's functions alone and restore it afterwards.
 
 With NUMBA_DISABLE_JIT=1 all of these are plain Python functions."""
@@ -54,9 +56,15 @@ def _kernel_hash() -> str:
 
 CACHE_DIR = Path(os.environ.get("OCEANMC_CACHE_DIR") or Path(__file__).parent / "__pycache__") \
     / f"numba-{_kernel_hash()}"
+CACHE_MARKER = ".oceanmc-kernel-cache"
 for _stale in CACHE_DIR.parent.glob("numba-*"):
-    if _stale != CACHE_DIR:
+    if _stale != CACHE_DIR and (_stale / CACHE_MARKER).is_file():
         shutil.rmtree(_stale, ignore_errors=True)  # caches of earlier kernel sources
+try:
+    CACHE_DIR.mkdir(parents=True, exist_ok=True)
+    (CACHE_DIR / CACHE_MARKER).touch()
+except OSError:
+    pass  # a read-only location: Numba then compiles without its cache, as before
 
 
 def _jit(**options):

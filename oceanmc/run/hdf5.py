@@ -51,7 +51,11 @@ def save_result(result: Result, path: str | Path) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
     os.close(fd)
     try:
-        with h5py.File(tmp, "w") as f:
+        # libver v110: attributes over 64 KB are stored densely. Each dataset attached to a
+        # dimension scale adds a reference to the scale's REFERENCE_LIST attribute; with one
+        # absorbed_layer_N quantity per layer, the batch scale of 4,100+ layers outgrew the
+        # compact 64 KB limit and H5DSattach_scale failed after the whole run.
+        with h5py.File(tmp, "w", libver=("v110", "latest")) as f:
             _write(f, result)
         umask = os.umask(0)
         os.umask(umask)

@@ -140,13 +140,14 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     step = 1e-6
     h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
                               lambda mu: transmittance(surface[0], mu))
+    cap_solid_angle = 4.0 * math.pi * math.sin(beta / 2.0) ** 2  # 2 pi (1 - cos beta), stably
     f, i = Pool(np.float64), Pool(np.int64)
     level_tau = column.level_tau
     rec = record(
         ESTIMATES, directions_on=int(len(dirs) > 0), cap_on=int(enabled), n_dirs=len(dirs),
         n_alpha=len(alphas), fine_end=fine_end, fine_step=fine_step, coarse_step=coarse_step,
-        fine_nodes=int(fine_nodes), mu_w=mu_w, omega_w=2.0 * math.pi * (1.0 - math.cos(beta)),
-        cos_water=math.cos(beta), mu_a=mu_a, omega_a=2.0 * math.pi * (1.0 - math.cos(beta)),
+        fine_nodes=int(fine_nodes), mu_w=mu_w, omega_w=cap_solid_angle,
+        cos_water=math.cos(beta), mu_a=mu_a, omega_a=cap_solid_angle,
         cos_air=math.cos(beta), h=float(h[1]), dh=float((h[2] - h[0]) / (2.0 * step)),
         dirs=f.add(dirs), air_factor=f.add(air_factor),
         **{f"cap_{name}": f.add(np.array(v)) for name, v in moments.items()},

@@ -145,7 +145,9 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
                          dtype=np.float64)
     fraction = upward_fractions(config.estimator, albedo)
-    up_cos = math.cos(math.radians(config.estimator.upward_cone_deg))
+    cone = math.radians(config.estimator.upward_cone_deg)
+    up_cos = math.cos(cone)
+    up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
 
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
@@ -154,7 +156,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
         layer_albedo=f.add(albedo), up_fraction=f.add(fraction),
-        up_density=f.add(fraction / (2.0 * math.pi * (1.0 - up_cos))),
+        up_density=f.add(fraction / up_solid_angle),
         up_keep=f.add(1.0 - fraction), comp_cumweight=f.add(cumweight),
         comp_params=f.add(comp_params),
         tab_psi=f.add(np.concatenate(psi_parts) if psi_parts else np.zeros(0)),

@@ -1,0 +1,161 @@
+"""Hardening (issue 13): malformed or extreme input gets one clear line and exit 2, never a
+wrong answer, a lost run or someone else's files deleted."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import REPO
+
+ENV = dict(os.environ, PYTHONPATH=str(REPO))
+
+
+def test_cache_dir_keeps_folders_oceanmc_did_not_create(tmp_path):
+    users = tmp_path / "numba-mine"
+    users.mkdir()
+    (users / "data.bin").write_bytes(b"x")
+    ours = tmp_path / "numba-0000000000000000"
+    ours.mkdir()
+    (ours / ".oceanmc-kernel-cache").touch()
+    env = dict(ENV, OCEANMC_CACHE_DIR=str(tmp_path))
+    subprocess.run([sys.executable, "-c", "import oceanmc.kernel.compile"], env=env, check=True,
+                   timeout=120)
+    assert (users / "data.bin").is_file()
+    assert not ours.exists()
+    current = [p for p in tmp_path.glob("numba-*") if p != users]
+    assert len(current) == 1 and (current[0] / ".oceanmc-kernel-cache").is_file()
+
+
+# --- configs: read safely, one line per problem -------------------------------------------
+
+import yaml  # noqa: E402
+
+from oceanmc.config import ConfigError, load_config  # noqa: E402
+
+
+def oceanmc(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "oceanmc", *map(str, args)], cwd=cwd, env=ENV,
+                          capture_output=True, text=True, timeout=600)
+
+
+def refused(source, *words, overrides=None):
+    with pytest.raises(ConfigError) as info:
+        load_config(source, overrides)
+    message = str(info.value)
+    assert "\n" not in message
+    for word in words:
+        assert word in message, (word, message)
+    return message
+
+
+def test_config_files_that_are_not_regular_or_too_large_are_refused(tmp_path):
+    refused("/dev/zero", "not a regular file")
+    refused(tmp_path, "not a regular file")
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    refused(fifo, "not a regular file")  # would block forever if opened for a blocking read
+    big = tmp_path / "big.yaml"
+    big.write_text("name: x\n" + "#" * (2 << 20))
+    refused(big, "larger than")
+    loop = tmp_path / "loop.yaml"
+    loop.symlink_to(loop)
+    refused(loop, "cannot read it")
+    refused(str(tmp_path / "a\0b.yaml"), "cannot read it")
+
+
+def test_yaml_alias_bomb_duplicate_keys_and_syntax_errors(tmp_path, small_scene):
+    bomb = tmp_path / "bomb.yaml"
+    lines = ["a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]"]
+    for level in "bcdefghi":
+        previous = chr(ord(level) - 1)
+        lines.append(f"{level}: &{level} [{', '.join(['*' + previous] * 10)}]")
+    bomb.write_text("\n".join(lines) + "\n")
+    message = refused(bomb, str(bomb), "aliases expand")
+    assert len(message) < 200
+    twice = tmp_path / "twice.yaml"
+    twice.write_text(yaml.safe_dump(small_scene) + "name: again\n")
+    refused(twice, str(twice), "'name' given twice")
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("name: a\nwater: {layers: [\n")
+    message = refused(broken, str(broken), "line 3")
+    assert "<unicode string>" not in message
+
+
+def test_photons_in_e_notation_and_blame_on_the_flag(tmp_path, small_scene):
+    small_scene["photons"] = "1e6"  # what YAML makes of `photons: 1e6`
+    assert load_config(small_scene).photons == 1_000_000
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene))
+    refused(path, "--photons", overrides={"photons": 3})
+    done = oceanmc("run", path, "--photons", "1e400", cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "--photons" in done.stderr
+
+
+@pytest.mark.parametrize("name", ["a\0b", "a\udc80b", "red \x1b[31m", "x" * 201])
+def test_names_that_cannot_be_stored_or_printed_are_refused(small_scene, name):
+    small_scene["name"] = name
+    refused(small_scene, "name")
+
+
+def test_unknown_key_suggests_the_nearest(small_scene):
+    small_scene["illumination"] = {"sun_zenit_deg": 30}
+    refused(small_scene, "did you mean sun_zenith_deg?")
+    small_scene["illumination"] = {}
+    small_scene["water"]["layers"][0]["phase"]["gg"] = 0.9
+    refused(small_scene, "did you mean")
+
+
+def test_all_configs_are_checked_before_any_runs(tmp_path, small_scene):
+    good = tmp_path / "good.yaml"
+    good.write_text(yaml.safe_dump(small_scene))
+    small_scene["bottom"] = {"model": "table", "file": "missing.h5"}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", good, bad, "-o", tmp_path / "out/", cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "missing.h5" in done.stderr
+    assert not (tmp_path / "out" / "good.h5").exists()
+
+
+# --- extreme but finite numbers: refused with one line, or computed without cancelling -----
+
+@pytest.mark.parametrize("change", [
+    lambda s: s["water"]["layers"][0].update(a=1e308, b=1e308),
+    lambda s: s["water"]["layers"][0].update(thickness_m=1e308),
+    lambda s: s["illumination"].update(Ed0=1e308),
+    lambda s: s.update(estimator={"max_events": 10**400}),
+    lambda s: s.update(estimator={"upward_fraction": 0.1, "upward_cone_deg": 1e-6}),
+])
+def test_huge_or_tiny_values_are_refused(small_scene, change):
+    change(small_scene)
+    refused(small_scene, "config: ")
+
+
+def test_small_upward_cone_density_does_not_cancel(small_scene):
+    import math
+    from oceanmc import scene
+    small_scene["estimator"] = {"upward_fraction": 0.1, "upward_cone_deg": 0.01}
+    config = load_config(small_scene)
+    built = scene.build(config)
+    cone = math.radians(0.01)
+    # 2 pi (1 - cos A) by its series 2 pi (A^2/2 - A^4/24), exact to 1e-20 relative here
+    solid_angle = 2.0 * math.pi * (cone ** 2 / 2.0 - cone ** 4 / 24.0)
+    density = built.mf[int(built.medium["up_density"][0])]
+    assert abs(density / (0.1 / solid_angle) - 1.0) < 1e-12
+
+
+def test_results_with_more_than_4100_layers_can_be_saved(tmp_path):
+    # one budget/absorbed_layer_N per layer, each attached to the batch dimension scale: the
+    # scale's reference list outgrew HDF5's 64 KB compact attribute limit at ~4,100 layers
+    import numpy as np
+    from oceanmc.run.hdf5 import COORD_UNITS, load_result
+    from oceanmc.run.results import Quantity, Result
+    names = [f"budget/absorbed_layer_{i + 1}" for i in range(4200)]
+    quantities = {name: Quantity(name, (), np.full(2, 0.5), "1", "absorbed") for name in names}
+    coords = {name: np.zeros(0) for name in COORD_UNITS if name != "batch"}
+    Result(coords, quantities, {"photons": 4}).save(tmp_path / "many.h5")
+    back = load_result(tmp_path / "many.h5")
+    assert len(back.quantities) == 4200
+    assert back.quantities[names[-1]].batches.tolist() == [0.5, 0.5]
