@@ -10,6 +10,7 @@ import oceanmc
 from oceanmc import scene
 from oceanmc.kernel import models
 from oceanmc.kernel.geometry import cos_sin_turn, from_angles, turn
+from oceanmc.kernel.rng import batch_state
 from oceanmc.kernel.surface.fresnel import fresnel, refract
 
 from stats_helpers import fresnel_reference
@@ -203,7 +204,8 @@ def test_flat_surface_sample_chooses_by_fresnel_with_unit_weight(theta_deg, up):
     assert r == pytest.approx(r_ref, abs=1e-15)
     assert (rx, ry, rz) == pytest.approx((ux, uy, -uz), abs=1e-15)
     u = (np.arange(20_000) + 0.5) / 20_000
-    picks = [dispatch.sample(surface, ux, uy, uz, v) for v in u]
+    rng = batch_state(1, 0)   # unused by a delta surface: u decides
+    picks = [dispatch.sample(surface, ux, uy, uz, v, rng) for v in u]
     reflected = np.array([not p[4] for p in picks])
     assert all(p[3] == 1.0 for p in picks)
     assert reflected.mean() == pytest.approx(r_ref, abs=1e-4)
