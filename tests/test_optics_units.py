@@ -182,10 +182,10 @@ def test_schlick_is_not_the_default():
 # --- the surface as a BSDF (kernel/surface/) ------------------------------------------------
 
 def surface_record(model="flat", n=1.34, schlick=0):
-    from oceanmc import registry
-    from oceanmc.kernel import records
-    return records.record(records.SURFACE, model=registry.surface_id(model), n_water=n,
-                          schlick=schlick)[0]
+    from oceanmc import config
+    from oceanmc.scene import surface
+    return surface.pack(config.Surface(model=model, fresnel="schlick" if schlick else "exact"),
+                        n)[0]
 
 
 @pytest.mark.parametrize("theta_deg, up", [(0.0, False), (40.0, False), (85.0, False),

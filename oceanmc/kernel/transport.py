@@ -200,14 +200,14 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
 
 
 @internal
-def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
+def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
     albedo = mf[medium.layer_albedo + layer]
     w = p.w
     if est.directions_on or est.cap_on:
-        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, p.seg, layer,
-                                    p.z, w * albedo, p.ux, p.uy, p.uz)
+        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p.seg,
+                                    layer, p.z, w * albedo, p.ux, p.uy, p.uz, rng)
     budget = grid.budget
     if ctrl.analog:
         if uniform(rng) >= albedo:
@@ -399,8 +399,8 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                                                   rng)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
-                    alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p,
-                                         where, walk_events, rng)
+                    alive, tau = collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei,
+                                         tally, p, where, walk_events, rng)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
                     if plane == PLANE_SURFACE:
