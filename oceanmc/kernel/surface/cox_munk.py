@@ -169,3 +169,29 @@ def walk(surface, ux, uy, uz, u, rng):
             z = -z
     oz = -z if from_air else z
     return x * wc - y * ws, x * ws + y * wc, oz, side < 0.0
+
+
+@kernel
+def glint_single(surface, sun_x, sun_y, sun_z, ox, oy, oz):
+    """The single-reflection glint: radiance leaving in the upward direction o per unit solar
+    irradiance on a plane normal to the beam travelling (sun_x, sun_y, sun_z):
+    F(i.m) p(zu, zc) G2 / (4 cos^4(theta_m) |oz|) (Cox & Munk 1954, eq. for the glitter
+    radiance; the microfacet form of Walter et al. 2007, eq. 20, with D = p / cos^4), m the
+    half vector and G2 = 1 / (1 + Lambda(i) + Lambda(o)) (Smith, height-correlated: the single
+    reflections of the walk above; Heitz 2014, JCGT 3(2), eq. 99). In oceanmc's frame (z down)."""
+    n = surface.n_water
+    # the walk's frame: x along the wind, z up; both vectors pointing away from the surface
+    wc, ws = surface.wind_cos, surface.wind_sin
+    ix, iy, iz = -(sun_x * wc + sun_y * ws), -(-sun_x * ws + sun_y * wc), sun_z
+    vx, vy, vz = ox * wc + oy * ws, -ox * ws + oy * wc, -oz
+    hx, hy, hz = ix + vx, iy + vy, iz + vz
+    norm = math.sqrt(hx * hx + hy * hy + hz * hz)
+    if hz <= 0.0 or norm == 0.0 or vz <= 0.0 or iz <= 0.0:
+        return 0.0
+    hx, hy, hz = hx / norm, hy / norm, hz / norm
+    au, ac = surface.alpha_u, surface.alpha_c
+    zu, zc = -hx / hz, -hy / hz
+    p = math.exp(-(zu * zu / (au * au) + zc * zc / (ac * ac))) / (math.pi * au * ac)
+    g2 = 1.0 / (1.0 + smith_lambda(au, ac, ix, iy, iz) + smith_lambda(au, ac, vx, vy, vz))
+    r = fresnel(1.0, n, ix * hx + iy * hy + iz * hz)[0]
+    return r * p * g2 / (4.0 * hz ** 4 * vz)

@@ -8,8 +8,11 @@ estimator uses split() for them instead (surface.delta), the expected-value form
 BSDF: both branches with their shares R and 1 - R. The rough surface (cox_munk.py) is sampled
 only, by its facet walk, with weight 1. Local estimates through a delta surface ask for
 transmittance(); through the rough one they sample the walk backwards (local_estimate.py)."""
-from ..compile import kernel
+import numpy as np
+
+from ..compile import kernel, setup
 from ..models import SURFACE_COX_MUNK, SURFACE_FLAT
+from ..rng import uniform
 from . import cox_munk, flat, index_matched
 
 
@@ -57,3 +60,17 @@ def transmittance(surface, mu):
     if surface.model == SURFACE_FLAT:
         return flat.transmittance(surface, mu)
     return index_matched.transmittance(surface, mu)
+
+
+@setup
+def reflected_from(surface, ox, oy, oz, n, rng):
+    """Where the light a viewer sees in the upward air direction o comes from after the
+    surface reflects it: n samples of the surface for a photon travelling -o from the air
+    (reciprocity: reflection is symmetric), each the direction of travel (downward) of the sky
+    light reflected into o, or a row of nan where that sample was transmitted instead."""
+    out = np.full((n, 3), np.nan)
+    for i in range(n):
+        dx, dy, dz, weight, transmitted = sample(surface, -ox, -oy, -oz, uniform(rng), rng)
+        if not transmitted:
+            out[i, 0], out[i, 1], out[i, 2] = -dx, -dy, -dz   # weight 1 (sample())
+    return out
