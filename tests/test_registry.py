@@ -10,7 +10,7 @@ import pytest
 
 from oceanmc import config as cfg
 from oceanmc import registry
-from oceanmc.kernel import models, records
+from oceanmc.kernel import models
 from oceanmc.kernel.brdf import dispatch as brdf_dispatch
 from oceanmc.kernel.phase import henyey_greenstein, isotropic, quadratic
 from oceanmc.kernel.surface import dispatch as surface_dispatch

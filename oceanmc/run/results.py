@@ -224,6 +224,13 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     add("air/Eou", (), air[:, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
     add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
         "upward plane irradiance at 0+ from light transmitted out of the water only")
+    at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
+    if len(at_surface):
+        eu_below = flux[:, at_surface[0], models.FLUX_EU]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            add("air/t_up", (), leaving[:, models.FLUX_EU] / eu_below, "1",
+                "upward transmittance of the surface for this run's upwelling light: "
+                "Eu_water_leaving(0+) / Eu(0-)")
     if radiance:
         def per_quad(values):
             out = values * scale / omega
