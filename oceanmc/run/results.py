@@ -225,12 +225,10 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
         "upward plane irradiance at 0+ from light transmitted out of the water only")
     at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
-    if len(at_surface):
-        eu_below = flux[:, at_surface[0], models.FLUX_EU]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            add("air/t_up", (), leaving[:, models.FLUX_EU] / eu_below, "1",
-                "upward transmittance of the surface for this run's upwelling light: "
-                "Eu_water_leaving(0+) / Eu(0-)")
+    if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
+        add("air/t_up", (), leaving[:, models.FLUX_EU] / flux[:, at_surface[0], models.FLUX_EU],
+            "1", "upward transmittance of the surface for this run's upwelling light: "
+            "Eu_water_leaving(0+) / Eu(0-) (absent when a batch has no upwelling light)")
     if radiance:
         def per_quad(values):
             out = values * scale / omega
@@ -270,12 +268,13 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
                 sky_down[:, mirror, :] -= beam
             # over the all-batch mean of L_sky: a batch's own sky quad may be empty
             sky_mean = sky_down.mean(axis=0)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                rho = np.where(upward & (sky_mean > 1e-12 * ed0), reflected / sky_mean, np.nan)
+            lit = upward & (sky_mean > 1e-12 * ed0)
+            rho = np.where(lit, reflected / np.where(lit, sky_mean, 1.0), 0.0)
             add("air/rho", ("theta", "phi"), rho, "1",
                 "sea-surface reflectance factor L_reflected / L_sky, L_sky the mean sky radiance "
                 "(sun excluded) of the quad a flat surface reflects into this one, averaged "
-                "over all batches (the standard error is L_reflected's); upward quads")
+                "over all batches (the standard error is L_reflected's); upward quads, 0 where "
+                "that quad has no sky light")
         add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
             "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
         add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
@@ -318,9 +317,10 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
         add("air/L_reflected_local", ("direction",), reflected, RAD_UNITS,
             "surface-reflected sky and sun radiance at 0+ in the exact directions of "
             "local_directions_deg (sky: surface samples; sun: single-reflection glint)")
-        add("air/rho_local", ("direction",), reflected / l_sky, "1",
-            "sea-surface reflectance factor L_reflected_local / L_sky, L_sky the sky radiance "
-            "(sun excluded) in the direction a flat surface reflects into the view")
+        if np.all(l_sky > 0.0):   # no sky, no rho
+            add("air/rho_local", ("direction",), reflected / l_sky, "1",
+                "sea-surface reflectance factor L_reflected_local / L_sky, L_sky the sky "
+                "radiance (sun excluded) in the direction a flat surface reflects into the view")
     budget = raw["budget"] / n_per_batch
     for column, name, description in budget_terms(n_layers):
         add(f"budget/{name}", (), budget[:, column], "1", description)
