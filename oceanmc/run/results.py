@@ -266,15 +266,14 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             sky_down[:, mirror, j] -= beam
             if grid.is_cap[i]:
                 sky_down[:, mirror, :] -= beam
-            # over the all-batch mean of L_sky: a batch's own sky quad may be empty
-            sky_mean = sky_down.mean(axis=0)
-            lit = upward & (sky_mean > 1e-12 * ed0)
-            rho = np.where(lit, reflected / np.where(lit, sky_mean, 1.0), 0.0)
+            # each batch's own ratio, so that batches stay independent and runs merge
+            lit = upward & (sky_down > 1e-12 * ed0)
+            rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)
             add("air/rho", ("theta", "phi"), rho, "1",
-                "sea-surface reflectance factor L_reflected / L_sky, L_sky the mean sky radiance "
-                "(sun excluded) of the quad a flat surface reflects into this one, averaged "
-                "over all batches (the standard error is L_reflected's); upward quads, 0 where "
-                "that quad has no sky light")
+                "sea-surface reflectance factor L_reflected / L_sky per batch, L_sky the mean "
+                "sky radiance (sun excluded) of the quad a flat surface reflects into this one; "
+                "upward quads, 0 where a batch has no sky light there (a ratio of batch means: "
+                "biased where few photons reach a quad; rho_local is exact)")
         add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
             "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
         add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
