@@ -58,6 +58,7 @@ BOTTOM = {
 SURFACE = {
     "none": (models.SURFACE_NONE, "index_matched"),
     "flat": (models.SURFACE_FLAT, "flat"),
+    "cox_munk": (models.SURFACE_COX_MUNK, "cox_munk"),
 }
 
 # Sky radiance shapes: schema name -> kernel model id; a map ({map: FILE}) is SKY_MAP or, with

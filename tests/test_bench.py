@@ -26,7 +26,8 @@ def test_quick_bench_writes_report(tmp_path):
                       "clear ocean, roulette at weight 1e-12",
                       "clear ocean, upward-biased scattering (fraction 0.1)",
                       "shallow sand", "shallow sand, upward-biased scattering (fraction 0.1)",
-                      "Snell's window",
+                      "Snell's window", "clear ocean (flat surface, exact nadir)",
+                      "clear ocean (rough sea 5 m/s, exact nadir)",
                       "sky map with a small bright spot (importance sampling)",
                       "sky map with a small bright spot (cosine sampling)",
                       "sky map with a small bright spot (cosine sampling, split_weight 2)"}

@@ -10,6 +10,7 @@ import oceanmc
 from oceanmc import scene
 from oceanmc.kernel import models
 from oceanmc.kernel.geometry import cos_sin_turn, from_angles, turn
+from oceanmc.kernel.rng import batch_state
 from oceanmc.kernel.surface.fresnel import fresnel, refract
 
 from stats_helpers import fresnel_reference
@@ -181,10 +182,10 @@ def test_schlick_is_not_the_default():
 # --- the surface as a BSDF (kernel/surface/) ------------------------------------------------
 
 def surface_record(model="flat", n=1.34, schlick=0):
-    from oceanmc import registry
-    from oceanmc.kernel import records
-    return records.record(records.SURFACE, model=registry.surface_id(model), n_water=n,
-                          schlick=schlick)[0]
+    from oceanmc import config
+    from oceanmc.scene import surface
+    return surface.pack(config.Surface(model=model, fresnel="schlick" if schlick else "exact"),
+                        n)[0]
 
 
 @pytest.mark.parametrize("theta_deg, up", [(0.0, False), (40.0, False), (85.0, False),
@@ -203,7 +204,8 @@ def test_flat_surface_sample_chooses_by_fresnel_with_unit_weight(theta_deg, up):
     assert r == pytest.approx(r_ref, abs=1e-15)
     assert (rx, ry, rz) == pytest.approx((ux, uy, -uz), abs=1e-15)
     u = (np.arange(20_000) + 0.5) / 20_000
-    picks = [dispatch.sample(surface, ux, uy, uz, v) for v in u]
+    rng = batch_state(1, 0)   # unused by a delta surface: u decides
+    picks = [dispatch.sample(surface, ux, uy, uz, v, rng) for v in u]
     reflected = np.array([not p[4] for p in picks])
     assert all(p[3] == 1.0 for p in picks)
     assert reflected.mean() == pytest.approx(r_ref, abs=1e-4)

@@ -10,7 +10,7 @@ import pytest
 
 from oceanmc import config as cfg
 from oceanmc import registry
-from oceanmc.kernel import models, records
+from oceanmc.kernel import models
 from oceanmc.kernel.brdf import dispatch as brdf_dispatch
 from oceanmc.kernel.phase import henyey_greenstein, isotropic, quadratic
 from oceanmc.kernel.surface import dispatch as surface_dispatch
@@ -97,9 +97,18 @@ def test_brdf_dispatch_reaches_each_reflecting_model():
 
 def test_surface_dispatch_reaches_each_model():
     """Flat reflects R > 0 of a photon from the air; index-matched reflects nothing and leaves
-    the direction unchanged."""
-    for name, (model_id, _) in registry.SURFACE.items():
-        surface = records.record(records.SURFACE, model=model_id, n_water=1.34, schlick=0)[0]
+    the direction unchanged; cox_munk (sampled only) spreads transmitted light over directions."""
+    from oceanmc.kernel.rng import batch_state
+    from oceanmc.scene import surface as surface_packer
+    for name in registry.SURFACE:
+        extra = {"wind_speed_m_s": 10.0} if name == "cox_munk" else {}
+        surface = surface_packer.pack(cfg.Surface(model=name, **extra), 1.34)[0]
+        if name == "cox_munk":
+            rng = batch_state(1, 0)
+            tz = {round(surface_dispatch.sample(surface, 0.6, 0.0, 0.8, 0.5, rng)[2], 12)
+                  for _ in range(20)}
+            assert len(tz) > 1
+            continue
         r, rx, ry, rz, tx, ty, tz = surface_dispatch.split(surface, 0.6, 0.0, 0.8)
         if name == "flat":
             assert 0.0 < r < 1.0 and tz > 0.8   # refracted toward the normal
@@ -107,3 +116,5 @@ def test_surface_dispatch_reaches_each_model():
             assert r == 0.0 and (tx, ty, tz) == (0.6, 0.0, 0.8)
         assert surface_dispatch.evaluate(surface, 0.6, 0.0, 0.8, rx, ry, rz) == 0.0
         assert surface_dispatch.pdf(surface, 0.6, 0.0, 0.8, rx, ry, rz) == 0.0
+
+

@@ -105,6 +105,15 @@ def scenes(configs_dir: Path) -> list[dict]:
          "quantities": [Quantity("Rrs nadir (local)", "air/Rrs_nadir"),
                         Quantity("Rrs nadir (crossing)", "air/Rrs_nadir_crossing"),
                         Quantity("Eu(0-)", "Eu", (0,))]},
+        # the rough sea against the flat one: exact-nadir Rrs by local estimates through the
+        # surface (each its own long run: the two surfaces give different Rrs)
+        {"name": f"clear ocean{FLAT_NADIR}", "reference": None,
+         "config": with_photons(clear, clear.photons, **NADIR_LOCAL),
+         "quantities": [Quantity("Rrs exact nadir (local)", "air/Rrs_local", (0,))]},
+        {"name": f"clear ocean{ROUGH_NADIR}", "reference": None,
+         "config": with_photons(clear, clear.photons, **NADIR_LOCAL, surface={
+             "model": "cox_munk", "n_water": clear.surface.n_water, "wind_speed_m_s": 5.0}),
+         "quantities": [Quantity("Rrs exact nadir (local)", "air/Rrs_local", (0,))]},
         {"name": "Snell's window", "config": snell, "reference": snell_window_reference(snell),
          "quantities": [Quantity("Ed(0-)", "Ed", (0,)),
                         Quantity("L cap down (0-)", "radiance", (0, 0, 0))]},
@@ -164,6 +173,11 @@ def sky_spot_scenes(map_path: Path) -> list[dict]:
              "reference": None, "quantities": quantities}]
 
 
+FLAT_NADIR, ROUGH_NADIR = " (flat surface, exact nadir)", " (rough sea 5 m/s, exact nadir)"
+NADIR_LOCAL = {"tallies.nadir_estimator": "crossing",
+               "tallies.local_directions_deg": [[180.0, 0.0]]}
+
+
 def with_photons(config, photons: int, **changes):
     data = copy.deepcopy(config.model_dump())
     data["photons"] = int(photons)
@@ -191,6 +205,8 @@ FEATURES: list[tuple[str, dict]] = [
     (f"+ upward-biased scattering (fraction {UPWARD_FRACTION:g}; shorter histories)",
      {"estimator.upward_fraction": UPWARD_FRACTION}),
     ("no surface (index-matched)", {"surface.model": "none"}),
+    ("rough surface (cox_munk, 5 m/s)", {"surface": {"model": "cox_munk", "n_water": 1.34,
+                                                     "wind_speed_m_s": 5.0}}),
     ("analog estimator", {"estimator.mode": "analog"}),
 ]
 

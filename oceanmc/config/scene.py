@@ -86,6 +86,10 @@ class SceneConfig(_Strict):
             raise ValueError(f"tallies.nadir_estimator = 'local' with bottom.model = "
                              f"{self.bottom.model!r}: a mirror has no density for a local "
                              "estimate; use 'crossing' or 'auto'")
+        if self.tallies.nadir_estimator == "local" and self.surface.model == "cox_munk":
+            raise ValueError("tallies.nadir_estimator = 'local' with surface.model = "
+                             "'cox_munk': the polar-cap tables assume a flat surface; use "
+                             "'crossing' or 'auto', or local_directions_deg: [[180, 0]]")
         if self.tallies.local_directions_deg and bottom_has_mirror(self.bottom):
             raise ValueError(f"tallies.local_directions_deg with bottom.model = "
                              f"{self.bottom.model!r}: a mirror has no density for a local "
@@ -106,7 +110,8 @@ class SceneConfig(_Strict):
     def nadir_local(self) -> bool:
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
         mode = self.tallies.nadir_estimator
-        return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom))
+        return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom)
+                                   and self.surface.model != "cox_munk")
 
     @property
     def wavelengths(self):
@@ -115,4 +120,4 @@ class SceneConfig(_Strict):
 
     @property
     def n_water(self) -> float:
-        return self.surface.n_water if self.surface.model == "flat" else 1.0
+        return self.surface.n_water if self.surface.model != "none" else 1.0

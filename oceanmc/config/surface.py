@@ -1,16 +1,62 @@
 """The air-water surface."""
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Literal, Optional
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from .base import _Strict
 
+# Cox & Munk (1954), J. Opt. Soc. Am. 44, 838, clean surface (wind speed U in m/s at 12.5 m):
+# mean square slope sigma^2 = 0.003 + 5.12e-3 U; upwind 3.16e-3 U, crosswind 0.003 + 1.92e-3 U
+CM_MSS = (0.003, 5.12e-3)
+CM_UPWIND = (0.0, 3.16e-3)
+CM_CROSSWIND = (0.003, 1.92e-3)
+
 
 class Surface(_Strict):
-    """flat: exact unpolarized Fresnel + Snell; none: no interface (index-matched, n = 1).
+    """flat: exact unpolarized Fresnel + Snell; none: no interface (index-matched, n = 1);
+    cox_munk: the wind-roughened sea, Gaussian facet slopes (Cox & Munk 1954) from
+    wind_speed_m_s (isotropic, or upwind/crosswind with wind_direction_deg: the azimuth the
+    wind blows toward, from the sun's rays' azimuth) or from mean_square_slope.
     fresnel: schlick swaps in Schlick's approximation, for comparisons only (never exact)."""
-    model: Literal["flat", "none"] = "flat"
+    model: Literal["flat", "none", "cox_munk"] = "flat"
     n_water: Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.34
     fresnel: Literal["exact", "schlick"] = "exact"
+    wind_speed_m_s: Optional[Annotated[float, Field(ge=0.0, le=30.0, allow_inf_nan=False)]] = None
+    mean_square_slope: Optional[Annotated[float, Field(ge=1e-6, le=0.5,
+                                                       allow_inf_nan=False)]] = None
+    wind_direction_deg: Optional[Annotated[float, Field(ge=-360.0, le=360.0,
+                                                        allow_inf_nan=False)]] = None
+
+    @model_validator(mode="after")
+    def _slopes_given_once(self) -> "Surface":
+        rough = (self.wind_speed_m_s, self.mean_square_slope, self.wind_direction_deg)
+        if self.model != "cox_munk":
+            if any(v is not None for v in rough):
+                raise ValueError(f"surface.model = {self.model!r} has no slopes: "
+                                 "wind_speed_m_s, mean_square_slope and wind_direction_deg "
+                                 "belong to surface.model = 'cox_munk'")
+            return self
+        if (self.wind_speed_m_s is None) == (self.mean_square_slope is None):
+            raise ValueError("surface.model = 'cox_munk' needs exactly one of wind_speed_m_s "
+                             "(0 to 30 m/s) and mean_square_slope (1e-6 to 0.5)")
+        if self.wind_direction_deg is not None and self.wind_speed_m_s is None:
+            raise ValueError(f"surface.wind_direction_deg = {self.wind_direction_deg} needs "
+                             "surface.wind_speed_m_s (the upwind/crosswind variances are "
+                             "functions of the wind speed); drop it with mean_square_slope")
+        if self.fresnel != "exact":
+            raise ValueError("surface.fresnel = 'schlick' with surface.model = 'cox_munk': "
+                             "the facets use exact Fresnel; allowed: 'exact'")
+        return self
+
+    def slope_variances(self) -> tuple[float, float]:
+        """(upwind, crosswind) slope variances; isotropic: half the mean square slope each."""
+        if self.mean_square_slope is not None:
+            return self.mean_square_slope / 2.0, self.mean_square_slope / 2.0
+        u = self.wind_speed_m_s
+        if self.wind_direction_deg is None:
+            mss = max(CM_MSS[0] + CM_MSS[1] * u, 1e-6)
+            return mss / 2.0, mss / 2.0
+        return (max(CM_UPWIND[0] + CM_UPWIND[1] * u, 1e-6),
+                CM_CROSSWIND[0] + CM_CROSSWIND[1] * u)

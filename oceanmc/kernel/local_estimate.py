@@ -11,6 +11,10 @@ the in-water radiance in the refracted direction is multiplied by the Fresnel tr
 References: Kalos & Whitlock, Monte Carlo Methods (2008), 6.3 (point detectors); Gordon (1985),
 Appl. Opt. 24, 4172 (ocean radiance by point estimates).
 
+Through the rough surface (surface.delta 0) an air row's in-water direction is not fixed: each
+collision or bottom reflection draws one from the surface's facet walk run backwards from the air
+direction (into_water_through_rough), an unbiased estimate with the same bounded scores.
+
 Only upward directions are offered: their paths from a collision to the level cross no surface.
 A mirror bottom has no density to evaluate, so scenes with one do not use these estimates.
 """
@@ -72,8 +76,26 @@ def cap_lookup(est, ef, table, cos_alpha):
 
 
 @internal
-def at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, seg, layer, z, w_scattered,
-                 ux, uy, uz):
+def into_water_through_rough(surface, est, ef, k, rng):
+    """(ix, iy, iz, t): for air row k (upward air direction o, stored as its flat-surface
+    refracted in-water direction), an in-water direction of travel i whose light the rough
+    surface sends into o, with t = 1, or t = 0 (nothing sent): one sample of the facet walk of
+    a photon travelling -o from the air, reversed. By the walk's reciprocity (f(i->o) / n_o^2 =
+    f(o->i) / n_i^2 for a dielectric BSDF; Veach 1997, PhD thesis, 5.2) the radiance L(o) at 0+
+    is the expectation of t L_water(i) / n^2, which the row's air factor 1/n^2 completes."""
+    dx, dy, dz = direction(est, ef, k)
+    n = surface.n_water
+    ax = n * dx
+    ay = n * dy
+    az = math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay))
+    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, -ax, -ay, az, uniform(rng),
+                                                          rng)
+    return -ox, -oy, -oz, weight if transmitted else 0.0
+
+
+@internal
+def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, seg, layer, z,
+                 w_scattered, ux, uy, uz, rng):
     """What one collision of a packet travelling (ux, uy, uz) sends into the exact directions
     (at every level above it and 0+), and the polar-cap average of the nadir-viewing radiance
     (see scene/estimates.py for the expansion and its accuracy). The levels are sorted by
@@ -82,7 +104,16 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, seg, layer, z, w_
     (water and air) whatever the number of levels."""
     tau_here = optical_depth(medium, mf, seg, layer, z)
     if est.directions_on:
+        rough = surface.delta == 0
         for k in range(est.n_dirs):
+            if rough and ef[est.air_factor + k] > 0.0:
+                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
+                if t > 0.0 and iz < 0.0:
+                    p = phase.evaluate(medium, mf, mi, layer, ux * ix + uy * iy + uz * iz)
+                    tally[grid.local + grid.n_depths * est.n_dirs + k] += (
+                        w_scattered * p * t * math.exp(tau_here / iz) / -iz
+                        * ef[est.air_factor + k])
+                continue
             dx, dy, dz = direction(est, ef, k)
             mu = -dz
             p = phase.evaluate(medium, mf, mi, layer, ux * dx + uy * dy + uz * dz)
@@ -120,7 +151,15 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, 
     tau_b = mf[medium.plane_tau + bottom_plane]
     model = bottom.model
     if est.directions_on:
+        rough = surface.delta == 0
         for k in range(est.n_dirs):
+            if rough and ef[est.air_factor + k] > 0.0:
+                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
+                if t > 0.0 and iz < 0.0:
+                    f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz)
+                    tally[grid.local + grid.n_depths * est.n_dirs + k] += (
+                        w * f * t * math.exp(tau_b / iz) * ef[est.air_factor + k])
+                continue
             dx, dy, dz = direction(est, ef, k)
             f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
             add_to_levels(est, ef, ei, grid, gf, tally, z, tau_b, k, w * f, -dz)

@@ -11,6 +11,7 @@ PHASE_TABULATED = 3      # piecewise-linear 2 pi p sin(psi) on nodes: Petzold, F
 # Air-water surfaces.
 SURFACE_NONE = 0         # no interface (index-matched)
 SURFACE_FLAT = 1         # flat: Fresnel + Snell
+SURFACE_COX_MUNK = 2     # wind-roughened: Gaussian facet slopes (Cox & Munk 1954)
 
 # Bottoms.
 BOTTOM_NONE = 0          # infinitely deep water: no bottom plane is ever reached

@@ -49,7 +49,11 @@ MEDIUM = _record(
           "comp_start", "comp_count", "comp_model", "comp_tab_start", "comp_tab_len"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
-SURFACE = _record("model", "n_water", "schlick", ints=("model", "schlick"))
+# delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
+# roughness along the wind and across it (alpha^2 = 2 x slope variance); wind_cos, wind_sin:
+# the wind's azimuth (cox_munk.py)
+SURFACE = _record("model", "n_water", "schlick", "delta", "alpha_u", "alpha_c", "wind_cos",
+                  "wind_sin", ints=("model", "schlick", "delta"))
 
 # The bottom (kernel/brdf/): model id; its parameters are the bottom pool (brdf_tables layout).
 BOTTOM = _record("model", "reflects", "mirror", ints=("model", "reflects", "mirror"))

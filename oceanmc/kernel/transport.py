@@ -108,14 +108,29 @@ def split(ctrl, stack, n_stacked, p):
 
 
 @internal
+def facet_walk(surface, p, rng):
+    """The rough surface in split()'s form: one sample of its facet walk (weight f cos / pdf
+    applied to p.w), as R = 1 into the reflected direction or R = 0 into the transmitted one,
+    so that the delta surface's expected-value scoring applies to it unchanged."""
+    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, p.ux, p.uy, p.uz,
+                                                          uniform(rng), rng)
+    p.w *= weight
+    return (0.0 if transmitted else 1.0), ox, oy, oz, ox, oy, oz
+
+
+@internal
 def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
-    implicit mode the whole solar beam of a batch enters in one call."""
+    implicit mode the whole solar beam of a batch enters a delta surface in one call."""
     air = grid.air_level
     w = p.w
     score_crossing(grid, gf, gi, tally, air, w, p.ux, p.uy, p.uz, p.beam)
-    r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    if surface.delta:
+        r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    else:
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, p, rng)
+        w = p.w
     if ctrl.analog:
         reflected = r > 0.0 and uniform(rng) < r
         w_reflected = w if reflected else 0.0
@@ -126,7 +141,7 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
     if w_reflected > 0.0:
         score_crossing(grid, gf, gi, tally, air, w_reflected, rx, ry, rz, p.beam)
         tally[grid.budget + BUDGET_SURFACE_REFLECTION] += w_reflected
-    if reflected:
+    if reflected or p.w <= 0.0:
         return False
     p.ux = tx
     p.uy = ty
@@ -185,14 +200,14 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
 
 
 @internal
-def collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
+def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
     albedo = mf[medium.layer_albedo + layer]
     w = p.w
     if est.directions_on or est.cap_on:
-        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, tally, p.seg, layer,
-                                    p.z, w * albedo, p.ux, p.uy, p.uz)
+        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p.seg,
+                                    layer, p.z, w * albedo, p.ux, p.uy, p.uz, rng)
     budget = grid.budget
     if ctrl.analog:
         if uniform(rng) >= albedo:
@@ -227,8 +242,12 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
-    an analog walk). Returns whether the packet goes on."""
-    r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    an analog walk; a rough surface: one sample of its facet walk). Returns whether the packet
+    goes on."""
+    if surface.delta:
+        r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
+    else:
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, p, rng)
     w = p.w
     if ctrl.analog:
         goes_on = r > 0.0 and uniform(rng) < r
@@ -337,9 +356,10 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     n_sun = n_photons - n_sky
     w_sun = (1.0 - f) * n_photons / n_sun if n_sun > 0 else 0.0
     analog = ctrl.analog
-    # in implicit mode every sun packet enters the same way, so the whole beam of the batch
-    # enters once, as packet -1, before the others, and each sun packet starts below the surface
-    beam_once = not analog and n_sun > 0
+    # in implicit mode every sun packet enters a delta surface the same way, so the whole beam
+    # of the batch enters once, as packet -1, before the others, and each sun packet starts
+    # below the surface; through a rough surface each sun packet enters on its own
+    beam_once = not analog and n_sun > 0 and surface.delta != 0
     w_sun_in, sx, sy, sz = beam_in[0], beam_in[1], beam_in[2], beam_in[3]
     events = 0
     n_stacked = 0   # the split stack is empty between photons
@@ -354,12 +374,12 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         elif from_sky:
             ux, uy, uz, weight = sky_direction(sky, sf, rng)
             w = weight * w_sky
-        elif analog:
+        elif not beam_once:
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         launch(p, w, ux, uy, uz, not from_sky)
-        if (i < 0 or from_sky or analog) and not enter_from_air(surface, ctrl, grid, gf, gi,
+        if (i < 0 or from_sky or not beam_once) and not enter_from_air(surface, ctrl, grid, gf, gi,
                                                                 tally, p, rng):
             continue
         if i < 0:
@@ -379,8 +399,8 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                                                   rng)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
-                    alive, tau = collide(medium, mf, mi, ctrl, grid, gf, est, ef, ei, tally, p,
-                                         where, walk_events, rng)
+                    alive, tau = collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei,
+                                         tally, p, where, walk_events, rng)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
                     if plane == PLANE_SURFACE:

@@ -64,8 +64,8 @@ def parts() -> dict[str, list[tuple]]:
     return {
         "bottom": [(transport.reflect_at_bottom, (medium, f8, surface, bottom, f8, ctrl, grid,
                                                   f8, est, f8, i8, f8, packet, u8))],
-        "water": [(transport.collide, (medium, f8, i8, ctrl, grid, f8, est, f8, i8, f8, packet,
-                                       int64, int64, u8)),
+        "water": [(transport.collide, (medium, f8, i8, surface, ctrl, grid, f8, est, f8, i8, f8,
+                                       packet, int64, int64, u8)),
                   (transport.enter_from_air, (surface, ctrl, grid, f8, i8, f8, packet, u8)),
                   (transport.leave_or_reflect, (surface, ctrl, grid, f8, i8, f8, packet, u8))],
         "entry": [(trace_batch, (row_medium, f8, i8, row_surface, row_bottom, f8, row_sky, f8,

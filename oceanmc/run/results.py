@@ -183,14 +183,21 @@ def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
     return terms
 
 
+def sun_of(config) -> tuple[float, float]:
+    """(sun zenith in deg, direct Ed(0+)) of a scene, for from_tallies."""
+    ill = config.illumination
+    return ill.sun_zenith_deg, ill.Ed0 * (1.0 - ill.diffuse_fraction)
+
+
 def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_batch: int,
                  ed0: float, n_layers: int, radiance: bool, attrs: dict,
-                 directions: list = (), local_rows: list = (), nadir_local: bool = False
-                 ) -> Result:
+                 directions: list = (), local_rows: list = (), nadir_local: bool = False,
+                 sun: tuple[float, float] | None = None) -> Result:
     """Normalises raw per-batch weight sums (per launched photon, times Ed0; radiances also per
     quad solid angle) and derives the contract's quantities. directions: the (theta, phi) of the
     local estimates, local_rows: their (water row, air row) in raw["local"]; nadir_local: Lu,
-    Lw_nadir and Rrs_nadir come from the local polar-cap estimate in raw["cap"]."""
+    Lw_nadir and Rrs_nadir come from the local polar-cap estimate in raw["cap"]; sun: (its
+    zenith angle in deg, direct Ed(0+)), for the sky radiance in rho (no rho without it)."""
     scale = ed0 / n_per_batch
     omega = grid.solid_angle
     q: dict[str, Quantity] = {}
@@ -217,6 +224,11 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     add("air/Eou", (), air[:, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
     add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
         "upward plane irradiance at 0+ from light transmitted out of the water only")
+    at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
+    if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
+        add("air/t_up", (), leaving[:, models.FLUX_EU] / flux[:, at_surface[0], models.FLUX_EU],
+            "1", "upward transmittance of the surface for this run's upwelling light: "
+            "Eu_water_leaving(0+) / Eu(0-) (absent when a batch has no upwelling light)")
     if radiance:
         def per_quad(values):
             out = values * scale / omega
@@ -236,6 +248,32 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             "radiance at 0+, all light: sun, sky, surface reflection, water-leaving")
         add("air/Lw", ("theta", "phi"), lw, RAD_UNITS,
             "water-leaving radiance at 0+ (surface-reflected light excluded); upward quads only")
+        upward = (grid.theta > 90.0)[:, None]
+        reflected = np.where(upward, air_rad - lw, 0.0)
+        add("air/L_reflected", ("theta", "phi"), reflected, RAD_UNITS,
+            "surface-reflected sun and sky radiance at 0+ (all light minus water-leaving); "
+            "upward quads only")
+        # the mirror of upward quad (theta, phi) is the downward quad (180 - theta, phi): its
+        # sky radiance, less the sun's collimated beam where it falls (Ed0 (1 - f) / (mu_s Omega))
+        edges = grid.theta_edges
+        if sun is not None and np.allclose(edges, 180.0 - edges[::-1]):
+            sky_down = air_rad[:, ::-1].copy()
+            theta_s, e_direct = sun
+            i = min(int(np.searchsorted(edges, theta_s, side="right")) - 1, len(edges) - 2)
+            j = 0 if grid.is_cap[i] else int(np.searchsorted(grid.phi_edges, 0.0, "right")) - 1
+            beam = e_direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
+            mirror = len(edges) - 2 - i
+            sky_down[:, mirror, j] -= beam
+            if grid.is_cap[i]:
+                sky_down[:, mirror, :] -= beam
+            # each batch's own ratio, so that batches stay independent and runs merge
+            lit = upward & (sky_down > 1e-12 * ed0)
+            rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)
+            add("air/rho", ("theta", "phi"), rho, "1",
+                "sea-surface reflectance factor L_reflected / L_sky per batch, L_sky the mean "
+                "sky radiance (sun excluded) of the quad a flat surface reflects into this one; "
+                "upward quads, 0 where a batch has no sky light there (a ratio of batch means: "
+                "biased where few photons reach a quad; rho_local is exact)")
         add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
             "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
         add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
@@ -273,6 +311,15 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
             "local (next-event) estimate")
         add("air/Rrs_local", ("direction",), local[:, n_depths][:, air_rows] / ed0, "sr-1",
             "Lw_local / Ed(0+)")
+    if "reflected_local" in raw:   # per batch: (L_reflected, L_sky of the mirror direction)
+        reflected, l_sky = raw["reflected_local"][..., 0], raw["reflected_local"][..., 1]
+        add("air/L_reflected_local", ("direction",), reflected, RAD_UNITS,
+            "surface-reflected sky and sun radiance at 0+ in the exact directions of "
+            "local_directions_deg (sky: surface samples; sun: single-reflection glint)")
+        if np.all(l_sky > 0.0):   # no sky, no rho
+            add("air/rho_local", ("direction",), reflected / l_sky, "1",
+                "sea-surface reflectance factor L_reflected_local / L_sky, L_sky the sky "
+                "radiance (sun excluded) in the direction a flat surface reflects into the view")
     budget = raw["budget"] / n_per_batch
     for column, name, description in budget_terms(n_layers):
         add(f"budget/{name}", (), budget[:, column], "1", description)

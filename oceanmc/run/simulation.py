@@ -30,7 +30,7 @@ from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
 from .compiling import ready
-from .results import Result, from_tallies
+from .results import Result, from_tallies, sun_of
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
@@ -180,10 +180,14 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         }
         part = {name: values[:done] for name, values in raw.items()}
         part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+        reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
+            if config.tallies.local_directions_deg else None
+        if reflected is not None:
+            part["reflected_local"] = reflected
         result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
                               ed0, n_layers, config.tallies.radiance, attrs,
                               config.tallies.local_directions_deg, sc.local_rows,
-                              config.nadir_local)
+                              config.nadir_local, sun_of(config))
         result.resume_state = state
         result.iops = iops_table(sc.layers, config.wavelengths)
         return result

@@ -36,8 +36,10 @@ def local_directions(config: cfg.SceneConfig, surface: np.ndarray
         sin_w = math.sin(theta) / n               # Snell: the in-water direction seen at 0+
         cos_w = math.sqrt(1.0 - sin_w * sin_w)
         refracted = (sin_w * math.cos(phi), sin_w * math.sin(phi), -cos_w)
-        factor = transmittance(surface[0], cos_w) / (n * n)
-        if np.allclose(in_water, refracted, atol=1e-15):
+        # through the rough surface the facet walk decides what leaves (local_estimate.py)
+        delta = bool(surface[0]["delta"])
+        factor = (transmittance(surface[0], cos_w) if delta else 1.0) / (n * n)
+        if delta and np.allclose(in_water, refracted, atol=1e-15):
             rows.append((len(dirs), len(dirs)))
             dirs.append(in_water), water.append(True), air.append(factor)
         else:

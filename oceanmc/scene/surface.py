@@ -1,13 +1,91 @@
 """The air-water surface packer: the SURFACE record (kernel/records.py)."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .. import config as cfg
 from .. import registry
 from ..kernel.records import SURFACE, record
+from . import sky_maps
 
 
 def pack(surface: cfg.Surface, n_water: float) -> np.ndarray:
+    if surface.model != "cox_munk":
+        return record(SURFACE, model=registry.surface_id(surface.model), n_water=float(n_water),
+                      schlick=int(surface.fresnel == "schlick"), delta=1, alpha_u=0.0,
+                      alpha_c=0.0, wind_cos=1.0, wind_sin=0.0)
+    upwind, crosswind = surface.slope_variances()
+    azimuth = math.radians(surface.wind_direction_deg or 0.0)
+    # Beckmann's alpha^2 is twice a slope component's variance (p ~ exp(-z^2 / alpha^2))
     return record(SURFACE, model=registry.surface_id(surface.model), n_water=float(n_water),
-                  schlick=int(surface.fresnel == "schlick"))
+                  schlick=0, delta=0, alpha_u=math.sqrt(2.0 * upwind),
+                  alpha_c=math.sqrt(2.0 * crosswind), wind_cos=math.cos(azimuth),
+                  wind_sin=math.sin(azimuth))
+
+
+# walks per batch and view direction for the reflected-radiance estimates (a few ms each)
+REFLECTED_SAMPLES = 4000
+
+
+def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray) -> np.ndarray | None:
+    """The sky's radiance (sun excluded) arriving in directions of travel dirs (downward), for
+    the analytic skies: uniform E_sky / pi; cardioidal (overcast) E_sky 3 (1 + 2 cos) / (7 pi)
+    (normalised so that integral L cos = E_sky). None for tabulated skies."""
+    e_sky = ill.Ed0 * ill.diffuse_fraction
+    if ill.sky == "uniform":
+        return np.full(len(dirs), e_sky / math.pi)
+    if ill.sky in ("cardioidal", "overcast"):
+        return e_sky * 3.0 * (1.0 + 2.0 * dirs[:, 2]) / (7.0 * math.pi)
+    if ill.sky == "harrison_coombes":
+        sun = sky_maps.sun_travel(ill.sun_zenith_deg)
+        cos_sun = max(sun[2], 1e-6)
+        # normalised so that integral L cos = E_sky (midpoint rule, 400 x 720 cells)
+        mu = (np.arange(400) + 0.5) / 400
+        phi = (np.arange(720) + 0.5) * (2.0 * math.pi / 720)
+        s = np.sqrt(1.0 - mu * mu)[:, None]
+        cos_psi = s * np.cos(phi)[None, :] * sun[0] + mu[:, None] * sun[2]
+        integral = (sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]
+                    ).sum() * (1.0 / 400) * (2.0 * math.pi / 720)
+        return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2], dirs @ sun, cos_sun)
+    return None
+
+
+def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: int,
+                    batches: int) -> np.ndarray | None:
+    """(batches, directions, 2): per batch, the surface-reflected sky and sun radiance in each
+    exact air direction of local_directions_deg (upward ones), and the sky radiance L_sky in
+    the direction a flat surface reflects into it (rho's denominator, DESIGN 7.3); None when
+    the sky is tabulated or no direction is upward. The sky part is a Monte Carlo average over
+    REFLECTED_SAMPLES surface samples per batch (own streams from (seed, batch, 1)); the sun's
+    part is the single-reflection glint (cox_munk.glint_single, exact up to the light the sun
+    sends by two facets or more), 0 for a delta surface."""
+    from ..kernel.surface import cox_munk
+    from ..kernel.surface.dispatch import reflected_from
+    ill = config.illumination
+    out = np.zeros((batches, len(config.tallies.local_directions_deg), 2))
+    theta_s = math.radians(ill.sun_zenith_deg)
+    sun = (math.sin(theta_s), 0.0, math.cos(theta_s))
+    e_sun = ill.Ed0 * (1.0 - ill.diffuse_fraction) / max(math.cos(theta_s), 1e-12)
+    for k, (theta_deg, phi_deg) in enumerate(config.tallies.local_directions_deg):
+        t, p = math.radians(theta_deg), math.radians(phi_deg)
+        o = (math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t))
+        if o[2] >= 0.0:
+            out[:, k] = np.nan
+            continue
+        mirror = np.array([[o[0], o[1], -o[2]]])
+        l_sky_mirror = sky_radiance(ill, mirror)
+        if l_sky_mirror is None:
+            return None
+        glint = 0.0 if surface["delta"] else e_sun * cox_munk.glint_single(surface, *sun, *o)
+        for b in range(batches):
+            state = np.random.SeedSequence(config.seed, spawn_key=(first_batch + b, 1)
+                                           ).generate_state(4, np.uint64)
+            came = reflected_from(surface, *o, REFLECTED_SAMPLES, state)
+            hit = ~np.isnan(came[:, 0])
+            sky = np.zeros(REFLECTED_SAMPLES)
+            if hit.any():
+                sky[hit] = sky_radiance(ill, came[hit])
+            out[b, k] = sky.mean() + glint, l_sky_mirror[0]
+    return out

@@ -1,30 +1,39 @@
 """The air-water surface as a BSDF component, by model id (ids and names: kernel/registry.py).
 
-Both surface models are delta BSDFs (a mirror and a refracted direction), so, as in Mitsuba 3
-and pbrt-v4, evaluate() and pdf() are 0 for every finite pair of directions and the light is
-carried by sample(), which returns the direction and the weight f cos / pdf: choosing reflection
-with probability R, each branch's weight is 1. The photon loop's implicit estimator uses split()
-instead, the expected-value form of the same BSDF: both branches with their shares R and 1 - R.
-Local estimates through the surface ask for transmittance()."""
-from ..compile import kernel
-from ..models import SURFACE_FLAT
-from . import flat, index_matched
+The flat and the index-matched surfaces are delta BSDFs (a mirror and a refracted direction),
+so, as in Mitsuba 3 and pbrt-v4, evaluate() and pdf() are 0 for every finite pair of directions
+and the light is carried by sample(), which returns the direction and the weight f cos / pdf:
+choosing reflection with probability R, each branch's weight is 1. The photon loop's implicit
+estimator uses split() for them instead (surface.delta), the expected-value form of the same
+BSDF: both branches with their shares R and 1 - R. The rough surface (cox_munk.py) is sampled
+only, by its facet walk, with weight 1. Local estimates through a delta surface ask for
+transmittance(); through the rough one they sample the walk backwards (local_estimate.py)."""
+import numpy as np
+
+from ..compile import kernel, setup
+from ..models import SURFACE_COX_MUNK, SURFACE_FLAT
+from ..rng import uniform
+from . import cox_munk, flat, index_matched
 
 
 @kernel
 def split(surface, ux, uy, uz):
     """(R, rx, ry, rz, tx, ty, tz): the share R reflected into (rx, ry, rz) and 1 - R
-    transmitted into (tx, ty, tz), for a photon travelling (ux, uy, uz) that meets the surface
-    from the air (uz > 0) or from the water (uz < 0)."""
+    transmitted into (tx, ty, tz), for a photon travelling (ux, uy, uz) that meets a delta
+    surface from the air (uz > 0) or from the water (uz < 0)."""
     if surface.model == SURFACE_FLAT:
         return flat.split(surface, ux, uy, uz)
     return index_matched.split(surface, ux, uy, uz)
 
 
 @kernel
-def sample(surface, ux, uy, uz, u):
-    """(ox, oy, oz, weight, transmitted): reflection when u < R, else transmission; the weight
-    f cos / pdf is 1 for either branch."""
+def sample(surface, ux, uy, uz, u, rng):
+    """(ox, oy, oz, weight, transmitted): the direction the photon leaves in and the weight
+    f cos / pdf, 1 for every model. u is the first uniform draw (a delta surface reflects when
+    u < R), rng the stream for any further ones (the rough surface's walk)."""
+    if surface.model == SURFACE_COX_MUNK:
+        ox, oy, oz, transmitted = cox_munk.walk(surface, ux, uy, uz, u, rng)
+        return ox, oy, oz, 1.0, transmitted
     r, rx, ry, rz, tx, ty, tz = split(surface, ux, uy, uz)
     if u < r:
         return rx, ry, rz, 1.0, False
@@ -33,7 +42,8 @@ def sample(surface, ux, uy, uz, u):
 
 @kernel
 def evaluate(surface, ux, uy, uz, ox, oy, oz):
-    """f for a finite pair of directions: 0 for a delta BSDF (Mitsuba's convention)."""
+    """f for a finite pair of directions: 0 for a delta BSDF (Mitsuba's convention); the rough
+    surface is not evaluated (its multiple-interaction BSDF has no closed form; it is sampled)."""
     return 0.0
 
 
@@ -45,7 +55,22 @@ def pdf(surface, ux, uy, uz, ox, oy, oz):
 
 @kernel
 def transmittance(surface, mu):
-    """The share of light travelling up at direction cosine mu in the water that leaves it."""
+    """The share of light travelling up at direction cosine mu in the water that leaves a delta
+    surface."""
     if surface.model == SURFACE_FLAT:
         return flat.transmittance(surface, mu)
     return index_matched.transmittance(surface, mu)
+
+
+@setup
+def reflected_from(surface, ox, oy, oz, n, rng):
+    """Where the light a viewer sees in the upward air direction o comes from after the
+    surface reflects it: n samples of the surface for a photon travelling -o from the air
+    (reciprocity: reflection is symmetric), each the direction of travel (downward) of the sky
+    light reflected into o, or a row of nan where that sample was transmitted instead."""
+    out = np.full((n, 3), np.nan)
+    for i in range(n):
+        dx, dy, dz, weight, transmitted = sample(surface, -ox, -oy, -oz, uniform(rng), rng)
+        if not transmitted:
+            out[i, 0], out[i, 1], out[i, 2] = -dx, -dy, -dz   # weight 1 (sample())
+    return out
