@@ -5,7 +5,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator
 
-from .base import Finite, NonNegative, _Strict
+from .base import MIN_ANGLE_DEG, Finite, NonNegative, _Strict
 
 HYDROLIGHT_THETA_EDGES_DEG = (0.0, 5.0, 15.0, 25.0, 35.0, 45.0, 55.0, 65.0, 75.0, 85.0, 90.0,
                               95.0, 105.0, 115.0, 125.0, 135.0, 145.0, 155.0, 165.0, 175.0, 180.0)
@@ -38,6 +38,9 @@ class Tallies(_Strict):
             raise ValueError(f"must start at 0 and end at 180 (deg), got {v}")
         if any(b <= a for a, b in zip(v, v[1:])):
             raise ValueError(f"must increase strictly, got {v}")
+        if any(b - a < MIN_ANGLE_DEG * (1.0 - 1e-9) for a, b in zip(v, v[1:])):  # 180 - 179.99
+            raise ValueError(f"bands must be at least {MIN_ANGLE_DEG} deg wide (float64 does not "
+                             f"resolve narrower ones near the poles), got {v}")
         if 90.0 not in v:
             raise ValueError(f"must include 90 so that no band straddles the horizontal, got {v}")
         return v

@@ -33,8 +33,10 @@ class Grid:
     @property
     def solid_angle(self) -> np.ndarray:
         """(theta, phi) quad solid angles in sr; a cap's full solid angle in every phi column."""
-        mu = np.cos(np.radians(self.theta_edges))
-        band = np.abs(mu[:-1] - mu[1:])
+        # cos a - cos b = 2 sin((a + b) / 2) sin((b - a) / 2): no cancelling for narrow bands
+        theta = np.radians(self.theta_edges)
+        band = np.abs(2.0 * np.sin(0.5 * (theta[1:] + theta[:-1]))
+                      * np.sin(0.5 * (theta[1:] - theta[:-1])))
         dphi = np.radians(np.diff(self.phi_edges))
         omega = band[:, None] * dphi[None, :]
         omega[self.is_cap, :] = 2.0 * math.pi * band[self.is_cap, None]
