@@ -89,9 +89,9 @@ class StopRequest:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .config import ConfigError, config_to_yaml, load_config
+    from .config import ConfigError, config_to_yaml, data_file_hashes, load_config
     from .run.hdf5 import load_result
-    from .run.results import MergeError, format_summary, merge_results
+    from .run.results import MergeError, check_same_data_files, format_summary, merge_results
     from .run.compiling import CompileInterrupted
     from .run.simulation import simulate
     from . import scene
@@ -125,6 +125,11 @@ def cmd_run(args: argparse.Namespace) -> int:
             if previous.config_yaml != config_to_yaml(config):
                 raise UsageError(f"--resume: {out} was made from a different scene than {path} "
                                  "(compare with `oceanmc show --config`)")
+            try:
+                check_same_data_files(previous.attrs, {"data_files_sha256":
+                                                       data_file_hashes(config)}, str(path))
+            except MergeError as exc:
+                raise UsageError(f"--resume: {exc}") from None
         scenes.append((path, out, config, previous))
 
     stop = StopRequest()

@@ -18,7 +18,8 @@ from .components import (CdomComponent, ChlorophyllComponent, Component, Constan
 from .estimator import Estimator
 from .illumination import (FlatSpectrum, Illumination, SkyMap, Spectrl2Spectrum, Spectrum,
                            SunPosition, TableSpectrum)
-from .loading import _describe, _key_path, _resolve_files, config_to_yaml, load_config
+from .loading import (_describe, _key_path, _resolve_files, config_to_yaml, data_file_hashes,
+                      load_config)
 from .phase import (BasicPhase, FournierForand, HenyeyGreenstein, Isotropic, Mixture,
                     MixtureComponent, Petzold, Phase, PureWater, Rayleigh, TablePhase, TwoTermHG)
 from .scene import SceneConfig

@@ -3,6 +3,8 @@ writing it back as YAML."""
 from __future__ import annotations
 
 import difflib
+import hashlib
+import json
 import os
 import stat
 import types
@@ -264,31 +266,52 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
     return config
 
 
-def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
-    """Table files are relative to the config file's folder; they are checked when the scene is
-    built (oceanmc/scene.py), which reports the file and the problem."""
-    def resolve(item) -> None:
-        item.file = str((base_dir / item.file).resolve())
-
+def _file_fields(config: SceneConfig) -> list[tuple[object, str]]:
+    """(model, attribute) of every data file the scene names: phase, component, profile and
+    spectrum tables, the bottom's BRDF table, the sky map."""
+    fields: list[tuple[object, str]] = []
     for layer in config.water.layers:
         phases = [c.phase for c in layer.phase.components] \
             if isinstance(layer.phase, Mixture) else [layer.phase]
         for component in layer.components or ():
             phases.append(getattr(component, "phase", None))
             if component.model == "table":
-                resolve(component)
+                fields.append((component, "file"))
             for value in component.__dict__.values():
                 if getattr(value, "profile", None) == "table":
-                    resolve(value)
-        for phase in phases:
-            if isinstance(phase, TablePhase):
-                resolve(phase)
+                    fields.append((value, "file"))
+        fields += [(phase, "file") for phase in phases if isinstance(phase, TablePhase)]
     if isinstance(config.bottom, TableBottom):
-        config.bottom.file = str((base_dir / config.bottom.file).resolve())
+        fields.append((config.bottom, "file"))
     if config.illumination.spectrum.model == "table":
-        resolve(config.illumination.spectrum)
+        fields.append((config.illumination.spectrum, "file"))
     if isinstance(config.illumination.sky, SkyMap):
-        config.illumination.sky.map = str((base_dir / config.illumination.sky.map).resolve())
+        fields.append((config.illumination.sky, "map"))
+    return fields
+
+
+def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
+    """Table files are relative to the config file's folder; they are checked when the scene is
+    built (oceanmc/scene.py), which reports the file and the problem."""
+    for model, attribute in _file_fields(config):
+        setattr(model, attribute, str((base_dir / getattr(model, attribute)).resolve()))
+
+
+def data_file_hashes(config: SceneConfig) -> str:
+    """JSON {path: sha256 of its content} of every data file the scene names: the stored config
+    holds only the paths, so merge and resume compare these to refuse an edited table."""
+    hashes = {}
+    for model, attribute in _file_fields(config):
+        path = getattr(model, attribute)
+        digest = hashlib.sha256()
+        try:
+            with open(path, "rb") as f:
+                while chunk := f.read(1 << 20):
+                    digest.update(chunk)
+            hashes[path] = digest.hexdigest()
+        except OSError as exc:   # the scene build reports it; this only records it
+            hashes[path] = f"unreadable ({exc.strerror})"
+    return json.dumps(hashes, sort_keys=True)
 
 
 def config_to_yaml(config: SceneConfig) -> str:

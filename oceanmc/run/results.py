@@ -6,6 +6,7 @@ batch values are stored, results of independent runs merge by concatenating batc
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -93,6 +94,21 @@ def _batch_ranges(part: Result) -> list[tuple[int, int, int]]:
     return [(int(part.attrs["seed"]), first, first + int(part.attrs["batches"]))]
 
 
+def check_same_data_files(stored: dict, current: dict, what: str) -> None:
+    """Raises MergeError naming the data file whose content (sha256 in data_files_sha256)
+    differs between two results' attrs; `what` names the second one in the message."""
+    try:
+        ours, theirs = (json.loads(str(attrs.get("data_files_sha256", "{}")))
+                        for attrs in (stored, current))
+        paths = sorted(set(ours) | set(theirs))
+    except (ValueError, TypeError):
+        raise MergeError(f"{what}: data_files_sha256 is not a mapping of file hashes") from None
+    for path in paths:
+        if ours.get(path) != theirs.get(path):
+            raise MergeError(f"the content of {path} differs for {what} (sha256): the results "
+                             "would mix two different scenes")
+
+
 def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
     """One Result from several runs of the same scene, by concatenating their batches (the
     standard errors then come from all batches together).
@@ -109,6 +125,7 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
         for part in parts[1:]:
             if part.config_yaml != first.config_yaml:
                 raise MergeError("the stored scene differs from the one being resumed")
+            check_same_data_files(first.attrs, part.attrs, "the resumed part")
         expected = int(first.attrs.get("first_batch", 0))
         for i, part in enumerate(parts):
             if int(part.attrs.get("first_batch", 0)) != expected:
@@ -122,6 +139,7 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
             if _scene_without(part.config_yaml, "seed", "photons", "name") != scene:
                 raise MergeError(f"result {i + 1} is a different scene (its water, surface, "
                                  "bottom, illumination, tallies or estimator differ)")
+            check_same_data_files(first.attrs, part.attrs, f"result {i + 1}")
             if part.attrs.get("photons_per_batch") != first.attrs.get("photons_per_batch"):
                 raise MergeError(f"result {i + 1} has {part.attrs.get('photons_per_batch')} "
                                  f"photons per batch, result 1 has "

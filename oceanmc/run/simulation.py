@@ -24,7 +24,7 @@ from tqdm import tqdm
 
 from .. import __version__, scene
 from ..optics import iops_table, monochromatic_illumination
-from ..config import SceneConfig, config_to_yaml, load_config
+from ..config import SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
@@ -91,6 +91,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     # compiles the kernel (or loads it from the cache) before the scene is packed, which uses it
     trace = ready(should_stop)
     startup = time.perf_counter() - t0
+    data_hashes = data_file_hashes(config)   # before the build reads them
     sc = scene.build(config)
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
@@ -164,6 +165,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         attrs = {
             "name": config.name,
             "config_yaml": config_to_yaml(config),
+            "data_files_sha256": data_hashes,
             "oceanmc_version": __version__,
             "numba_version": numba.__version__,
             "seed": config.seed,
