@@ -15,7 +15,7 @@ class _Strict(BaseModel):
 
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
-# The narrowest cone or band accepted (deg): its 1 - cos, 1.5e-10, is resolved by float64
+# The narrowest theta band accepted (deg): its 1 - cos, 1.5e-10, is resolved by float64
 # direction cosines (spacing 1.1e-16 below 1) to 1e-6 relative; 1 - cos(1e-6 deg) = 1.5e-16 is not.
 MIN_ANGLE_DEG = 0.001
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
