@@ -124,7 +124,6 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     beta_w = math.asin(math.sin(beta) / n)
     mu_w = 0.5 * (1.0 + math.cos(beta))
     mu_a = 0.5 * (1.0 + math.cos(beta_w))
-    cap_solid_angle = 4.0 * math.pi * math.sin(0.5 * beta) ** 2   # 2 pi (1 - cos beta), stably
     fine_end, fine_step, coarse_step, fine_nodes = cap_tables.alpha_grid(beta)
     alphas = cap_tables.alpha_nodes(beta)
     enabled = config.nadir_local
