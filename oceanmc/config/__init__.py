@@ -21,12 +21,13 @@ from .scene import SceneConfig
 from .surface import Surface
 from .tallies import HYDROLIGHT_THETA_EDGES_DEG, Tallies
 from .water import Layer, Water
+from .wavelengths import WavelengthRange
 
 __all__ = [
     "ConfigError", "Finite", "NonNegative", "Fraction", "Asymmetry",
     "Isotropic", "Rayleigh", "PureWater", "HenyeyGreenstein", "TwoTermHG", "FournierForand",
     "Petzold", "TablePhase", "BasicPhase", "MixtureComponent", "Mixture", "Phase",
-    "Layer", "Water",
+    "Layer", "Water", "WavelengthRange",
     "SkyMap", "Illumination",
     "Surface",
     "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",

@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from .base import _Strict
 from .bottom import Bottom, bottom_has_mirror, bottom_weight_bounded
@@ -13,6 +13,7 @@ from .illumination import Illumination
 from .surface import Surface
 from .tallies import Tallies
 from .water import Water
+from .wavelengths import Wavelengths, check_increasing, grid
 
 
 class SceneConfig(_Strict):
@@ -26,6 +27,12 @@ class SceneConfig(_Strict):
     bottom: Bottom
     tallies: Tallies = Field(default_factory=Tallies)
     estimator: Estimator = Field(default_factory=Estimator)
+    wavelengths_nm: Wavelengths | None = None
+
+    @field_validator("wavelengths_nm")
+    @classmethod
+    def _increasing(cls, value: Wavelengths | None) -> Wavelengths | None:
+        return check_increasing(value)
 
     @model_validator(mode="after")
     def _consistent(self) -> "SceneConfig":
@@ -38,6 +45,7 @@ class SceneConfig(_Strict):
                              "(thickness_m: .inf); a finite water column needs a bottom "
                              "(black, lambertian, minnaert, specular, lambertian_specular, "
                              "ggx, hapke, table)")
+        self.water.check_wavelength_count(len(self.wavelengths), self.wavelengths_nm is not None)
         depth = self.water.depth_m
         for d in self.tallies.depths_m:
             if d > depth * (1.0 + 1e-12):
@@ -71,6 +79,11 @@ class SceneConfig(_Strict):
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
         mode = self.tallies.nadir_estimator
         return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom))
+
+    @property
+    def wavelengths(self):
+        """The wavelength grid (nm, numpy array); [nan] for a monochromatic scene."""
+        return grid(self.wavelengths_nm)
 
     @property
     def n_water(self) -> float:

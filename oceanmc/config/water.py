@@ -1,20 +1,46 @@
-"""The water column: layers of absorption a, scattering b and a phase function."""
+"""The water column: layers of absorption a, scattering b and a phase function; a and b (and the
+backscatter fraction bb_ratio, which makes the phase function Fournier-Forand) may be lists, one
+value per wavelength of `wavelengths_nm`."""
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import Annotated, Union
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from .base import NonNegative, _Strict
 from .phase import Isotropic, Mixture, Phase
 
+BackscatterRatio = Annotated[float, Field(ge=0.0005, le=0.45, allow_inf_nan=False)]
+
+
+def _one_or_list(value) -> str:
+    return "spectral_list" if isinstance(value, list) else "spectral_value"
+
+
+def spectral(number):
+    """One number, or a list of them (one per wavelength); the discriminator makes a bad value
+    report the error of the form it was given in, not of both."""
+    return Annotated[Union[Annotated[number, Tag("spectral_value")],
+                           Annotated[Annotated[list[number], Field(min_length=1)],
+                                     Tag("spectral_list")]],
+                     Discriminator(_one_or_list)]
+
+
+Spectral = spectral(NonNegative)
+
+
+def values(value: float | list[float]) -> list[float]:
+    """A spectral key's values: a list as given, one number as a list of one."""
+    return list(value) if isinstance(value, list) else [value]
+
 
 class Layer(_Strict):
     thickness_m: Annotated[float, Field(gt=0.0)]
-    a: NonNegative
-    b: NonNegative | None = None
-    phase: Phase = Field(default_factory=lambda: Isotropic(model="isotropic"))
+    a: Spectral
+    b: Spectral | None = None
+    phase: Phase | None = None         # isotropic unless bb_ratio is given
+    bb_ratio: spectral(BackscatterRatio) | None = None
 
     @field_validator("thickness_m")
     @classmethod
@@ -25,10 +51,18 @@ class Layer(_Strict):
 
     @model_validator(mode="after")
     def _scattering(self) -> "Layer":
+        if self.bb_ratio is not None and self.phase is not None:
+            raise ValueError("bb_ratio and phase both given: bb_ratio makes the phase function "
+                             "Fournier-Forand with that backscatter fraction; give one")
+        if self.bb_ratio is None and self.phase is None:
+            self.phase = Isotropic(model="isotropic")
         if isinstance(self.phase, Mixture):
             total = sum(c.b for c in self.phase.components)
             if self.b is None:
                 self.b = total
+            elif isinstance(self.b, list):
+                raise ValueError("b is a list with phase.model = 'mixture', whose components "
+                                 "carry their own b; give b as one number or leave it out")
             elif not math.isclose(self.b, total, rel_tol=1e-9, abs_tol=1e-12):
                 raise ValueError(f"b = {self.b} differs from the sum of the mixture's component b "
                                  f"({total}); give one or make them agree")
@@ -47,10 +81,28 @@ class Water(_Strict):
                 if i != len(self.layers) - 1:
                     raise ValueError(f"layers[{i}].thickness_m = .inf: only the last layer may be "
                                      "infinitely deep")
-                if layer.a == 0.0 and layer.b > 0.0:
+                a, b = values(layer.a), values(layer.b)
+                if any(b[k % len(b)] > 0.0 and a[k % len(a)] == 0.0
+                       for k in range(max(len(a), len(b)))):
                     raise ValueError(f"layers[{i}]: an infinitely deep layer that scatters (b > 0) "
                                      "needs a > 0, or photons never leave it")
         return self
+
+    def check_wavelength_count(self, n_wavelengths: int, spectral: bool) -> None:
+        """Every list has one value per wavelength; lists need `wavelengths_nm`."""
+        for i, layer in enumerate(self.layers):
+            for key in ("a", "b", "bb_ratio"):
+                value = getattr(layer, key)
+                if not isinstance(value, list):
+                    continue
+                if not spectral:
+                    raise ValueError(f"water.layers[{i}].{key} is a list ({len(value)} values) "
+                                     "but wavelengths_nm is not given; give wavelengths_nm or "
+                                     "one number")
+                if len(value) != n_wavelengths:
+                    raise ValueError(f"water.layers[{i}].{key} has {len(value)} values; allowed: "
+                                     f"one number or one value per wavelength "
+                                     f"({n_wavelengths} in wavelengths_nm)")
 
     @property
     def depth_m(self) -> float:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
+from .. import optics
 from ..kernel import models
 from ..kernel.records import MEDIUM, Pool, record
 from . import phase_tables
@@ -58,12 +59,12 @@ def phase_components(phase) -> list[tuple[float, int, list[float], tuple | None]
     return COMPONENTS[phase.model](phase)
 
 
-def planes(config: cfg.SceneConfig):
+def planes(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]):
     """Plane depths (surface first, bottom or inf last), the tally level at each plane (-1 for
     none), the layer of each segment between planes, the level tallied at 0- (or -1), and the
     tally depths (snapped onto layer boundaries they differ from only by rounding)."""
     bounds = [0.0]
-    for layer in config.water.layers:
+    for layer in layers:
         bounds.append(bounds[-1] + layer.thickness_m)
     # a tally depth that differs from a layer boundary only by rounding (the sum of many thin
     # layers) is that boundary, not a sliver of a segment beside it
@@ -99,13 +100,17 @@ def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray
 
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
     """(MEDIUM record, float pool, int pool, Column)."""
-    layers = config.water.layers
+    layers = optics.column_iops(config)
+    if len(config.wavelengths) > 1:
+        raise cfg.ConfigError(f"wavelengths_nm has {len(config.wavelengths)} entries: this "
+                              "build traces one wavelength at a time; give one")
     comp_start, comp_count, cumweight, comp_model, comp_params = [], [], [], [], []
     tab_start, tab_len, psi_parts, q_parts, cdf_parts = [], [], [], [], []
     tab_offset = 0
     table_at: dict[int, tuple[int, int]] = {}
     for layer in layers:
-        comps = phase_components(layer.phase)
+        comps = [(share * w, m, p, t) for phase, share in zip(layer.phases, layer.weights[0])
+                 if share > 0.0 for w, m, p, t in phase_components(phase)]
         comp_start.append(len(comp_model))
         comp_count.append(len(comps))
         total = sum(w for w, *_ in comps)
@@ -130,9 +135,9 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
             tab_len.append(table_at[key][1])
         cumweight[-1] = 1.0
 
-    plane_z, plane_tally, segment_layer, surface_level, depths = planes(config)
-    layer_c = np.array([layer.a + layer.b for layer in layers], dtype=np.float64)
-    albedo = np.array([layer.b / (layer.a + layer.b) if layer.b > 0.0 else 0.0
+    plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
+    layer_c = np.array([layer.c[0] for layer in layers], dtype=np.float64)
+    albedo = np.array([layer.b[0] / layer.c[0] if layer.b[0] > 0.0 else 0.0
                        for layer in layers], dtype=np.float64)
     plane_tau = optical_depths(plane_z, segment_layer, layer_c)
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],

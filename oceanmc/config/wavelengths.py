@@ -1,0 +1,62 @@
+"""The wavelength grid: `wavelengths_nm`, a list of wavelengths (nm) or {start, stop, step}."""
+from __future__ import annotations
+
+import math
+from typing import Annotated, Union
+
+import numpy as np
+from pydantic import Discriminator, Field, Tag, model_validator
+
+from .base import _Strict
+
+Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+MAX_WAVELENGTHS = 10_000
+
+
+class WavelengthRange(_Strict):
+    """start, start + step, ... up to stop (included when it falls on the grid), in nm."""
+    start: Wavelength
+    stop: Wavelength
+    step: Wavelength
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "WavelengthRange":
+        if self.stop < self.start:
+            raise ValueError(f"stop = {self.stop} is below start = {self.start}; allowed: "
+                             "stop >= start")
+        if (self.stop - self.start) / self.step + 1 > MAX_WAVELENGTHS:
+            raise ValueError(f"{{start: {self.start}, stop: {self.stop}, step: {self.step}}} "
+                             f"gives more than {MAX_WAVELENGTHS} wavelengths")
+        return self
+
+    def grid(self) -> np.ndarray:
+        # the stop is included when it lies on the grid up to rounding (400..700 by 10: 31 entries)
+        count = math.floor((self.stop - self.start) / self.step * (1.0 + 1e-12) + 1e-9) + 1
+        return self.start + self.step * np.arange(count, dtype=np.float64)
+
+
+WavelengthList = Annotated[list[Wavelength], Field(min_length=1, max_length=MAX_WAVELENGTHS)]
+Wavelengths = Annotated[
+    Union[Annotated[WavelengthList, Tag("wavelength_list")],
+          Annotated[WavelengthRange, Tag("wavelength_range")]],
+    Discriminator(lambda v: "wavelength_range" if isinstance(v, (dict, WavelengthRange))
+                  else "wavelength_list")]
+
+
+def check_increasing(value: Wavelengths | None) -> Wavelengths | None:
+    """A list must be strictly increasing (one line naming the first offending pair)."""
+    if isinstance(value, list):
+        for i in range(1, len(value)):
+            if not value[i] > value[i - 1]:
+                raise ValueError(f"must be strictly increasing; entry {i} ({value[i]} nm) follows "
+                                 f"{value[i - 1]} nm")
+    return value
+
+
+def grid(value: Wavelengths | None) -> np.ndarray:
+    """The wavelengths (nm) of the scene; a monochromatic scene (None) has one, NaN."""
+    if value is None:
+        return np.array([np.nan])
+    if isinstance(value, WavelengthRange):
+        return value.grid()
+    return np.asarray(value, dtype=np.float64)
