@@ -288,6 +288,19 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     return Result(coords, q, attrs)
 
 
+def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
+    """One Result from the per-wavelength Results of a spectral run: every quantity gains a
+    leading `wavelength` dimension (nm; the coordinate `wavelength`), after the batch axis."""
+    first = parts[0]
+    quantities = {
+        name: Quantity(name, ("wavelength",) + q.dims,
+                       np.stack([p.quantities[name].batches for p in parts], axis=1),
+                       q.units, q.description)
+        for name, q in first.quantities.items()}
+    coords = dict(first.coords, wavelength=np.asarray(wavelengths, dtype=np.float64))
+    return Result(coords, quantities, dict(first.attrs))
+
+
 # --- the printed summary -----------------------------------------------------------------------
 
 def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:

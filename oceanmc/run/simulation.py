@@ -22,13 +22,13 @@ import numba
 import numpy as np
 from tqdm import tqdm
 
-from .. import __version__, scene
+from .. import __version__, optics, scene
 from ..config import SceneConfig, config_to_yaml, load_config
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
 from .compiling import ready
-from .results import Result, from_tallies
+from .results import Result, from_tallies, stack_wavelengths
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
@@ -103,7 +103,9 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
     stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
-    raw = dict(tally_views(sc.grid, tallies), events=events)
+    n_wl = len(config.wavelengths)
+    raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
+    ed0 = optics.illumination_spectrum(config)[0]
     args = sc.kernel_args()
     # a batch's lock is held through each of its calls, so that a checkpoint copies its state
     # between two calls
@@ -161,13 +163,16 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "wall_time_s": wall,
             "startup_time_s": startup,
             "photons_per_s": photons / wall if wall > 0 else float("inf"),
-            "scattering_events": int(raw["events"][:done].sum()),
+            "scattering_events": int(events[:done].sum()),
         }
-        part = {name: values[:done] for name, values in raw.items()}
-        result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
-                              config.illumination.Ed0, n_layers, config.tallies.radiance, attrs,
-                              config.tallies.local_directions_deg, sc.local_rows,
-                              config.nadir_local)
+        per_wavelength = [
+            from_tallies({name: values[:done] for name, values in raw.items()}, sc.angles,
+                         np.array(depths), n_per_batch, float(ed0[k]), n_layers,
+                         config.tallies.radiance, attrs, config.tallies.local_directions_deg,
+                         sc.local_rows, config.nadir_local)
+            for k, raw in enumerate(raws)]
+        result = per_wavelength[0] if config.wavelengths_nm is None else \
+            stack_wavelengths(per_wavelength, config.wavelengths)
         result.resume_state = state
         return result
 
