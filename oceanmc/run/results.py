@@ -345,7 +345,7 @@ def format_spectrum(result: Result) -> list[str]:
     first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
     columns = [(head.replace("z1", first), name, index)
                for head, name, index in SPECTRAL_COLUMNS if name in result]
-    lines = [f"  {'nm':>6}" + "".join(f"{head:>15}" for head, _, _ in columns)]
+    lines = [f"  {'nm':>6}" + "".join(f" {head:>15}" for head, _, _ in columns)]
     for k, wavelength in enumerate(result.coords["wavelength"]):
         cells = []
         for _, name, index in columns:
@@ -353,8 +353,8 @@ def format_spectrum(result: Result) -> list[str]:
             if index is not None:
                 value, err = value[index], err[index]
             rel = abs(err / value) if value != 0.0 else 0.0
-            cells.append(f"{value:>9.4g} {rel:>4.1%}")
-        lines.append(f"  {wavelength:>6g}" + "".join(f"{cell:>15}" for cell in cells))
+            cells.append(f"{value:>9.4g} {rel:>5.1%}")
+        lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>15}" for cell in cells))
     lines.append("  (value and relative standard error; budget fractions of Ed(0+); every "
                  "quantity per wavelength in the file)")
     return lines
