@@ -31,6 +31,16 @@ PHASE = {
     "mixture": (),   # a weighted sum of the others
 }
 
+# Water constituents (config/components.py): schema model -> module in optics/components/
+CONSTITUENT = {
+    "pure_water": "pure_water",
+    "chlorophyll": "chlorophyll",
+    "cdom": "cdom",
+    "particles": "particles",
+    "table": "table",
+    "constant": "constant",
+}
+
 # Bottom BRDFs: schema model -> (kernel model id, module in kernel/brdf/ or None)
 BOTTOM = {
     "none": (models.BOTTOM_NONE, None),

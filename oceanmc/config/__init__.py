@@ -12,8 +12,12 @@ from .base import Asymmetry, ConfigError, Finite, Fraction, NonNegative, _Strict
 from .bottom import (BlackBottom, Bottom, GGXBottom, HapkeBottom, LambertianBottom,
                      LambertianSpecularBottom, MinnaertBottom, NoBottom, Sampling, SpecularBottom,
                      TableBottom, bottom_has_mirror, bottom_weight_bounded)
+from .components import (CdomComponent, ChlorophyllComponent, Component, ConstantComponent,
+                         GaussianProfile, LinearProfile, ParticlesComponent, Profile,
+                         PureWaterComponent, TableComponent, TableProfile)
 from .estimator import Estimator
-from .illumination import Illumination, SkyMap
+from .illumination import (FlatSpectrum, Illumination, SkyMap, Spectrl2Spectrum, Spectrum,
+                           SunPosition, TableSpectrum)
 from .loading import _describe, _key_path, _resolve_files, config_to_yaml, load_config
 from .phase import (BasicPhase, FournierForand, HenyeyGreenstein, Isotropic, Mixture,
                     MixtureComponent, Petzold, Phase, PureWater, Rayleigh, TablePhase, TwoTermHG)
@@ -28,7 +32,11 @@ __all__ = [
     "Isotropic", "Rayleigh", "PureWater", "HenyeyGreenstein", "TwoTermHG", "FournierForand",
     "Petzold", "TablePhase", "BasicPhase", "MixtureComponent", "Mixture", "Phase",
     "Layer", "Water", "WavelengthRange",
-    "SkyMap", "Illumination",
+    "GaussianProfile", "LinearProfile", "TableProfile", "Profile", "PureWaterComponent",
+    "ChlorophyllComponent", "CdomComponent", "ParticlesComponent", "TableComponent",
+    "ConstantComponent", "Component",
+    "SkyMap", "Illumination", "SunPosition", "FlatSpectrum", "Spectrl2Spectrum", "TableSpectrum",
+    "Spectrum",
     "Surface",
     "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",
     "SpecularBottom", "LambertianSpecularBottom", "GGXBottom", "HapkeBottom", "TableBottom",

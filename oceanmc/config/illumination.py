@@ -1,11 +1,12 @@
 """Illumination: the sun, and the sky (a named model or a radiance map from a file)."""
 from __future__ import annotations
 
+import datetime as dt
 from typing import Annotated, Literal, Union
 
 from pydantic import Discriminator, Field, Tag, model_validator
 
-from .base import Fraction, _Strict
+from .base import Fraction, NonNegative, _Strict
 
 
 class SkyMap(_Strict):
@@ -34,6 +35,50 @@ class SkyMap(_Strict):
         return self
 
 
+class SunPosition(_Strict):
+    """The sun's zenith angle from the time (ISO 8601; without a zone it is UTC) and the place
+    (degrees north, degrees east), by pvlib's solar position (NREL SPA, Reda & Andreas 2004)."""
+    time: dt.datetime
+    latitude_deg: Annotated[float, Field(ge=-90.0, le=90.0, allow_inf_nan=False)]
+    longitude_deg: Annotated[float, Field(ge=-180.0, le=180.0, allow_inf_nan=False)]
+
+
+class FlatSpectrum(_Strict):
+    """Ed0 and diffuse_fraction the same at every wavelength."""
+    model: Literal["flat"]
+
+
+class Spectrl2Spectrum(_Strict):
+    """The clear-sky spectral model SPECTRL2 (Bird & Riordan 1986, J. Clim. Appl. Meteorol. 25,
+    87), by pvlib.spectrum.spectrl2, on a horizontal surface at sea level (300-4000 nm): Ed0(l)
+    the global horizontal irradiance (W m-2 nm-1, times illumination.Ed0), diffuse_fraction(l)
+    its diffuse share. The atmosphere's parameters are SPECTRL2's (defaults: pvlib's and Bird &
+    Riordan's)."""
+    model: Literal["spectrl2"]
+    surface_pressure_pa: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 101325.0
+    precipitable_water_cm: NonNegative = 1.42
+    ozone_atm_cm: NonNegative = 0.344
+    aerosol_turbidity_500nm: NonNegative = 0.1
+    scattering_albedo_400nm: Fraction = 0.945
+    alpha: NonNegative = 1.14
+    wavelength_variation_factor: NonNegative = 0.095
+    aerosol_asymmetry_factor: Annotated[float, Field(gt=-1.0, lt=1.0,
+                                                     allow_inf_nan=False)] = 0.65
+    # else sun_position's day, else 4 April (Earth-Sun distance 1 AU)
+    day_of_year: Annotated[int, Field(ge=1, le=366)] | None = None
+
+
+class TableSpectrum(_Strict):
+    """A CSV with columns wavelength_nm, Ed0 (times illumination.Ed0) and diffuse_fraction,
+    linearly interpolated."""
+    model: Literal["table"]
+    file: str
+
+
+Spectrum = Annotated[Union[FlatSpectrum, Spectrl2Spectrum, TableSpectrum],
+                     Field(discriminator="model")]
+
+
 class Illumination(_Strict):
     """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
     Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
@@ -46,3 +91,28 @@ class Illumination(_Strict):
                          Annotated[SkyMap, Tag("SkyMap")]],
                    Discriminator(lambda v: "SkyMap" if isinstance(v, (dict, SkyMap))
                                  else "sky_name")] = "uniform"
+    # spectral illumination (oceanmc/optics/illumination.py); with spectrl2 or table, Ed0 scales
+    # the spectrum and diffuse_fraction comes from it
+    spectrum: Spectrum = Field(default_factory=lambda: FlatSpectrum(model="flat"))
+    sun_position: SunPosition | None = None
+
+    @model_validator(mode="after")
+    def _sun_and_spectrum(self) -> "Illumination":
+        if self.spectrum.model != "flat" and self.diffuse_fraction != 0.0:
+            raise ValueError(f"diffuse_fraction = {self.diffuse_fraction} with spectrum.model = "
+                             f"{self.spectrum.model!r}, which gives the diffuse share per "
+                             "wavelength; leave diffuse_fraction out")
+        if self.sun_position is not None:
+            from ..optics.sun import zenith_deg   # pvlib: imported only when used
+            zenith = zenith_deg(self.sun_position)
+            if zenith >= 90.0:
+                raise ValueError(f"sun_position: the sun is {zenith - 90.0:.2f} deg below the "
+                                 f"horizon at {self.sun_position.time.isoformat()} (latitude "
+                                 f"{self.sun_position.latitude_deg}, longitude "
+                                 f"{self.sun_position.longitude_deg}); allowed: a daytime sun")
+            if "sun_zenith_deg" in self.model_fields_set \
+                    and abs(self.sun_zenith_deg - zenith) > 1e-6:
+                raise ValueError(f"sun_zenith_deg = {self.sun_zenith_deg} and sun_position "
+                                 f"(zenith {zenith:.6f} deg) both given; give one")
+            self.sun_zenith_deg = zenith
+        return self

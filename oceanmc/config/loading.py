@@ -32,9 +32,10 @@ def _union_tags(root: type[BaseModel]) -> frozenset[str]:
         elif origin in (Union, types.UnionType):
             for member in get_args(tp):
                 if isinstance(member, type) and issubclass(member, BaseModel):
-                    field = member.model_fields.get("model")
-                    if field is not None and get_origin(field.annotation) is Literal:
-                        tags.update(get_args(field.annotation))
+                    for key in ("model", "profile"):   # the discriminating keys
+                        field = member.model_fields.get(key)
+                        if field is not None and get_origin(field.annotation) is Literal:
+                            tags.update(get_args(field.annotation))
                 visit(member)
         elif isinstance(tp, type) and issubclass(tp, BaseModel):
             if tp not in seen:
@@ -75,11 +76,12 @@ def _describe(error: dict) -> str:
         return f"{path}: unknown key (check its spelling and level)"
     if kind == "missing":
         return f"{path}: required key is missing"
+    key = str(ctx.get("discriminator", "model")).strip("'")   # model, or a profile's profile
     if kind == "union_tag_invalid":
-        return (f"{path}.model = {ctx.get('tag')!r}: unknown model; allowed: "
+        return (f"{path}.{key} = {ctx.get('tag')!r}: unknown {key}; allowed: "
                 f"{ctx.get('expected_tags')}")
     if kind == "union_tag_not_found":
-        return f"{path}.model: required key is missing"
+        return f"{path}.{key}: required key is missing"
     if path == "(top level)" and kind == "value_error":
         return msg
     if "input" in error and not isinstance(error["input"], dict):
@@ -144,14 +146,26 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
 def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
     """Table files are relative to the config file's folder; they are checked when the scene is
     built (oceanmc/scene.py), which reports the file and the problem."""
+    def resolve(item) -> None:
+        item.file = str((base_dir / item.file).resolve())
+
     for layer in config.water.layers:
         phases = [c.phase for c in layer.phase.components] \
             if isinstance(layer.phase, Mixture) else [layer.phase]
+        for component in layer.components or ():
+            phases.append(getattr(component, "phase", None))
+            if component.model == "table":
+                resolve(component)
+            for value in component.__dict__.values():
+                if getattr(value, "profile", None) == "table":
+                    resolve(value)
         for phase in phases:
             if isinstance(phase, TablePhase):
-                phase.file = str((base_dir / phase.file).resolve())
+                resolve(phase)
     if isinstance(config.bottom, TableBottom):
         config.bottom.file = str((base_dir / config.bottom.file).resolve())
+    if config.illumination.spectrum.model == "table":
+        resolve(config.illumination.spectrum)
     if isinstance(config.illumination.sky, SkyMap):
         config.illumination.sky.map = str((base_dir / config.illumination.sky.map).resolve())
 

@@ -89,5 +89,10 @@ class SceneConfig(_Strict):
         return grid(self.wavelengths_nm)
 
     @property
+    def wavelengths(self):
+        """The wavelength grid (nm, numpy array); [nan] for a monochromatic scene."""
+        return grid(self.wavelengths_nm)
+
+    @property
     def n_water(self) -> float:
         return self.surface.n_water if self.surface.model == "flat" else 1.0

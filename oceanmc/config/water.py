@@ -4,30 +4,14 @@ value per wavelength of `wavelengths_nm`."""
 from __future__ import annotations
 
 import math
-from typing import Annotated, Union
+from typing import Annotated
 
-from pydantic import Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
-from .base import NonNegative, _Strict
+from .base import _Strict
+from .components import Component
 from .phase import Isotropic, Mixture, Phase
-
-BackscatterRatio = Annotated[float, Field(ge=0.0005, le=0.45, allow_inf_nan=False)]
-
-
-def _one_or_list(value) -> str:
-    return "spectral_list" if isinstance(value, list) else "spectral_value"
-
-
-def spectral(number):
-    """One number, or a list of them (one per wavelength); the discriminator makes a bad value
-    report the error of the form it was given in, not of both."""
-    return Annotated[Union[Annotated[number, Tag("spectral_value")],
-                           Annotated[Annotated[list[number], Field(min_length=1)],
-                                     Tag("spectral_list")]],
-                     Discriminator(_one_or_list)]
-
-
-Spectral = spectral(NonNegative)
+from .wavelengths import BackscatterRatio, Spectral, spectral
 
 
 def values(value: float | list[float]) -> list[float]:
@@ -37,10 +21,11 @@ def values(value: float | list[float]) -> list[float]:
 
 class Layer(_Strict):
     thickness_m: Annotated[float, Field(gt=0.0)]
-    a: Spectral
+    a: Spectral | None = None
     b: Spectral | None = None
     phase: Phase | None = None         # isotropic unless bb_ratio is given
     bb_ratio: spectral(BackscatterRatio) | None = None
+    components: Annotated[list[Component], Field(min_length=1, max_length=32)] | None = None
 
     @field_validator("thickness_m")
     @classmethod
@@ -51,6 +36,15 @@ class Layer(_Strict):
 
     @model_validator(mode="after")
     def _scattering(self) -> "Layer":
+        if self.components is not None:
+            given = [k for k in ("a", "b", "phase", "bb_ratio") if getattr(self, k) is not None]
+            if given:
+                raise ValueError(f"{', '.join(given)} given with components: a layer is described "
+                                 "by its components or by a, b and phase; for constant IOPs "
+                                 "beside constituents add {model: constant, a: ..., b: ...}")
+            return self
+        if self.a is None:
+            raise ValueError("a (absorption coefficient, 1/m) or components is required")
         if self.bb_ratio is not None and self.phase is not None:
             raise ValueError("bb_ratio and phase both given: bb_ratio makes the phase function "
                              "Fournier-Forand with that backscatter fraction; give one")
@@ -81,6 +75,8 @@ class Water(_Strict):
                 if i != len(self.layers) - 1:
                     raise ValueError(f"layers[{i}].thickness_m = .inf: only the last layer may be "
                                      "infinitely deep")
+                if layer.components is not None:
+                    continue   # checked per wavelength when the IOPs are resolved (optics)
                 a, b = values(layer.a), values(layer.b)
                 if any(b[k % len(b)] > 0.0 and a[k % len(a)] == 0.0
                        for k in range(max(len(a), len(b)))):
@@ -91,6 +87,9 @@ class Water(_Strict):
     def check_wavelength_count(self, n_wavelengths: int, spectral: bool) -> None:
         """Every list has one value per wavelength; lists need `wavelengths_nm`."""
         for i, layer in enumerate(self.layers):
+            if layer.components is not None and not spectral:
+                raise ValueError(f"water.layers[{i}].components: constituents need "
+                                 "wavelengths_nm (a list in nm, or {start, stop, step})")
             for key in ("a", "b", "bb_ratio"):
                 value = getattr(layer, key)
                 if not isinstance(value, list):

@@ -7,7 +7,7 @@ from typing import Annotated, Union
 import numpy as np
 from pydantic import Discriminator, Field, Tag, model_validator
 
-from .base import _Strict
+from .base import NonNegative, _Strict
 
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 MAX_WAVELENGTHS = 10_000
@@ -60,3 +60,23 @@ def grid(value: Wavelengths | None) -> np.ndarray:
     if isinstance(value, WavelengthRange):
         return value.grid()
     return np.asarray(value, dtype=np.float64)
+
+
+# per-wavelength keys (water.layers[i].a, b, bb_ratio; components): one number or one per wavelength
+BackscatterRatio = Annotated[float, Field(ge=0.0005, le=0.45, allow_inf_nan=False)]
+
+
+def _one_or_list(value) -> str:
+    return "spectral_list" if isinstance(value, list) else "spectral_value"
+
+
+def spectral(number):
+    """One number, or a list of them (one per wavelength); the discriminator makes a bad value
+    report the error of the form it was given in, not of both."""
+    return Annotated[Union[Annotated[number, Tag("spectral_value")],
+                           Annotated[Annotated[list[number], Field(min_length=1)],
+                                     Tag("spectral_list")]],
+                     Discriminator(_one_or_list)]
+
+
+Spectral = spectral(NonNegative)

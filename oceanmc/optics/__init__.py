@@ -7,9 +7,9 @@ the kernel's records.
     column_iops(config) -> [LayerIOPs, ...] top to bottom
     illumination_spectrum(config) -> (Ed0 (n_wl,), diffuse_fraction (n_wl,), sun_zenith_deg)
 """
-from .column import LayerIOPs, column_iops, wavelengths
-from .illumination import illumination_spectrum
+from .column import LayerIOPs, column_iops, iops_table, wavelengths
+from .illumination import illumination_spectrum, monochromatic_illumination
 from .phases import backscatter_fraction
 
 __all__ = ["wavelengths", "LayerIOPs", "column_iops", "illumination_spectrum",
-           "backscatter_fraction"]
+           "backscatter_fraction", "monochromatic_illumination", "iops_table"]

@@ -1,14 +1,80 @@
-"""The illumination per wavelength: Ed(0+), its diffuse (sky) share and the sun's zenith angle."""
+"""The illumination per wavelength: Ed(0+), its diffuse (sky) share and the sun's zenith angle
+(config/illumination.py: spectrum flat, spectrl2 or table; sun_zenith_deg or sun_position)."""
 from __future__ import annotations
 
 import numpy as np
 
 from .. import config as cfg
+from ..config import ConfigError
+from .tables import columns, interpolate, read_csv
+
+# the day of year SPECTRL2's Earth-Sun distance correction uses when neither day_of_year nor
+# sun_position is given: 4 April, when the distance is 1 AU to 0.1%
+MEAN_DISTANCE_DAY = 94
+
+
+def spectrl2(spectrum: cfg.Illumination, zenith_deg: float, day_of_year: int | None,
+             wl: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(global horizontal irradiance W m-2 nm-1, diffuse share) of SPECTRL2 (Bird & Riordan
+    1986) on a horizontal surface, by pvlib; relative air mass of Kasten & Young (1989)."""
+    import pvlib
+    model = spectrum
+    airmass = pvlib.atmosphere.get_relative_airmass(zenith_deg)
+    out = pvlib.spectrum.spectrl2(
+        apparent_zenith=zenith_deg, aoi=zenith_deg, surface_tilt=0.0, ground_albedo=0.0,
+        surface_pressure=model.surface_pressure_pa, relative_airmass=airmass,
+        precipitable_water=model.precipitable_water_cm, ozone=model.ozone_atm_cm,
+        aerosol_turbidity_500nm=model.aerosol_turbidity_500nm, dayofyear=day_of_year,
+        scattering_albedo_400nm=model.scattering_albedo_400nm, alpha=model.alpha,
+        wavelength_variation_factor=model.wavelength_variation_factor,
+        aerosol_asymmetry_factor=model.aerosol_asymmetry_factor)
+    nodes = np.asarray(out["wavelength"], dtype=np.float64)
+    total = np.ravel(out["poa_global"])
+    diffuse = np.ravel(out["poa_sky_diffuse"])
+    where = "illumination.spectrum"
+    ed0 = interpolate(wl, nodes, total, where, "SPECTRL2 (Bird & Riordan 1986)")
+    sky = interpolate(wl, nodes, diffuse, where, "SPECTRL2 (Bird & Riordan 1986)")
+    return ed0, np.divide(sky, ed0, out=np.zeros_like(sky), where=ed0 > 0.0)
 
 
 def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, float]:
     """(Ed0 (n_wl,), diffuse_fraction (n_wl,), sun_zenith_deg)."""
-    n_wl = len(config.wavelengths)
+    wl = config.wavelengths
     light = config.illumination
-    return (np.full(n_wl, float(light.Ed0)), np.full(n_wl, float(light.diffuse_fraction)),
-            float(light.sun_zenith_deg))
+    spectrum = light.spectrum
+    zenith = float(light.sun_zenith_deg)
+    if spectrum.model == "flat":
+        return (np.full(len(wl), float(light.Ed0)), np.full(len(wl), float(light.diffuse_fraction)),
+                zenith)
+    if np.isnan(wl).any():
+        raise ConfigError(f"illumination.spectrum.model = {spectrum.model!r} needs "
+                          "wavelengths_nm")
+    if spectrum.model == "spectrl2":
+        day = spectrum.day_of_year or (light.sun_position.time.timetuple().tm_yday
+                                       if light.sun_position else MEAN_DISTANCE_DAY)
+        ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
+    else:
+        table = read_csv(spectrum.file)
+        where = "illumination.spectrum.file"
+        columns(table, ("wavelength_nm", "Ed0", "diffuse_fraction"), where, spectrum.file)
+        if np.any(table["Ed0"] < 0.0) or np.any((table["diffuse_fraction"] < 0.0)
+                                                | (table["diffuse_fraction"] > 1.0)):
+            raise ConfigError(f"{where}: {spectrum.file}: Ed0 must be >= 0 and "
+                              "diffuse_fraction within 0..1")
+        ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where, spectrum.file)
+                        for name in ("Ed0", "diffuse_fraction"))
+    if np.any(ed0 <= 0.0):
+        raise ConfigError(f"illumination.spectrum: Ed0 = 0 at {wl[ed0 <= 0.0][0]:g} nm; every "
+                          "wavelength needs light")
+    return float(light.Ed0) * ed0, diffuse, zenith
+
+
+def monochromatic_illumination(config: cfg.SceneConfig) -> cfg.Illumination:
+    """The illumination of a one-wavelength scene as the flat one the packers take (Ed0 and
+    diffuse_fraction of its spectrum at that wavelength)."""
+    light = config.illumination
+    if light.spectrum.model == "flat":
+        return light
+    ed0, diffuse, _ = illumination_spectrum(config)
+    return light.model_copy(update={"Ed0": float(ed0[0]), "diffuse_fraction": float(diffuse[0]),
+                                    "spectrum": cfg.FlatSpectrum(model="flat")})

@@ -109,6 +109,32 @@ def _write(f: h5py.File, result: Result) -> None:
         group.attrs["description"] = RESUME_DESCRIPTION
         for name, values in result.resume_state.items():
             group.create_dataset(name, data=values)
+    if result.iops:
+        _write_iops(f.create_group("iops"), result.iops)
+
+
+IOPS_COORDS = {"layer_top": ("m", "depth of the top of each homogeneous layer (a depth profile "
+                                  "is resolved into several)"),
+               "wavelength": ("nm", "wavelength in vacuum (NaN: a monochromatic scene)")}
+IOPS_VALUES = {"a": "absorption coefficient", "b": "scattering coefficient",
+               "bb": "backscattering coefficient", "c": "beam attenuation coefficient a + b"}
+
+
+def _write_iops(group: h5py.Group, iops: dict[str, np.ndarray]) -> None:
+    """The IOPs the run used, per layer and wavelength, with their own dimension scales."""
+    for dim, (units, description) in IOPS_COORDS.items():
+        ds = group.create_dataset(dim, data=iops[dim])
+        ds.make_scale(dim)
+        ds.attrs["units"], ds.attrs["description"] = units, description
+    thickness = group.create_dataset("layer_thickness", data=iops["layer_thickness"])
+    thickness.attrs["units"] = "m"
+    thickness.attrs["description"] = "thickness of each layer (inf: infinitely deep)"
+    thickness.dims[0].attach_scale(group["layer_top"])
+    for name, description in IOPS_VALUES.items():
+        ds = group.create_dataset(name, data=iops[name])
+        ds.attrs["units"], ds.attrs["description"] = "1/m", description
+        ds.dims[0].attach_scale(group["layer_top"])
+        ds.dims[1].attach_scale(group["wavelength"])
 
 
 def load_result(path: str | Path) -> Result:
@@ -130,7 +156,8 @@ def load_result(path: str | Path) -> Result:
         resume_state = None
         if RESUME_GROUP in f:
             resume_state = {name: f[RESUME_GROUP][name][()] for name in RESUME_FIELDS}
-    return Result(coords, quantities, attrs, resume_state)
+        iops = {name: ds[()] for name, ds in f["iops"].items()} if "iops" in f else {}
+    return Result(coords, quantities, attrs, resume_state, iops)
 
 
 def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:

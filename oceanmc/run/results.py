@@ -44,6 +44,9 @@ class Result:
     attrs: dict[str, object] = field(default_factory=dict)
     # a partial run's unfinished batches, from which --resume continues them (simulation.py)
     resume_state: dict[str, np.ndarray] | None = None
+    # the IOPs the run used (optics.iops_table): a, b, bb, c (layer, wavelength) in 1/m and the
+    # coordinates layer_top (m), layer_thickness (m), wavelength (nm); the file's group `iops`
+    iops: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.quantities[name].mean
@@ -153,7 +156,7 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
         attrs["merged_from"] = len(parts)
     # a resumed run's unfinished batches are those of its last part
     return Result(dict(first.coords), quantities, attrs,
-                  parts[-1].resume_state if resume else None)
+                  parts[-1].resume_state if resume else None, dict(first.iops))
 
 
 # --- building a Result from raw kernel tallies ------------------------------------------------

@@ -22,8 +22,10 @@ import numba
 import numpy as np
 from tqdm import tqdm
 
-from .. import __version__, optics, scene
+from .. import __version__, scene
+from ..optics import iops_table, illumination_spectrum
 from ..config import SceneConfig, config_to_yaml, load_config
+from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
@@ -51,6 +53,17 @@ def next_budget(budget: int, seconds: float) -> int:
 
 def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h" if seconds < 48 * 3600 else f"{seconds / 86400:.1f} days"
+
+
+def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int) -> np.ndarray:
+    """The budget with the absorption of the sublayers of a depth profile summed into the
+    configured layer they resolve."""
+    if len(config_layer) == n_layers:
+        return budget
+    out = np.zeros(budget.shape[:-1] + (BUDGET_LAYERS + n_layers,))
+    out[..., :BUDGET_LAYERS] = budget[..., :BUDGET_LAYERS]
+    np.add.at(out.T, BUDGET_LAYERS + config_layer, budget[..., BUDGET_LAYERS:].T)
+    return out
 
 
 def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
@@ -84,6 +97,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_batches = config.batches - first_batch
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
+    config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
     depths = config.tallies.depths_m
     # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
     # beam (weight per sun packet, direction), scattering events, tally row
@@ -105,7 +119,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
     n_wl = len(config.wavelengths)
     raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
-    ed0 = optics.illumination_spectrum(config)[0]
+    ed0 = illumination_spectrum(config)[0]
     args = sc.kernel_args()
     # a batch's lock is held through each of its calls, so that a checkpoint copies its state
     # between two calls
@@ -165,15 +179,18 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "photons_per_s": photons / wall if wall > 0 else float("inf"),
             "scattering_events": int(events[:done].sum()),
         }
-        per_wavelength = [
-            from_tallies({name: values[:done] for name, values in raw.items()}, sc.angles,
-                         np.array(depths), n_per_batch, float(ed0[k]), n_layers,
-                         config.tallies.radiance, attrs, config.tallies.local_directions_deg,
-                         sc.local_rows, config.nadir_local)
-            for k, raw in enumerate(raws)]
+        per_wavelength = []
+        for k, raw in enumerate(raws):
+            part = {name: values[:done] for name, values in raw.items()}
+            part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+            per_wavelength.append(from_tallies(
+                part, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
+                config.tallies.radiance, attrs, config.tallies.local_directions_deg,
+                sc.local_rows, config.nadir_local))
         result = per_wavelength[0] if config.wavelengths_nm is None else \
             stack_wavelengths(per_wavelength, config.wavelengths)
         result.resume_state = state
+        result.iops = iops_table(sc.layers, config.wavelengths)
         return result
 
     t1 = last_checkpoint = time.perf_counter()

@@ -36,6 +36,7 @@ class Scene:
     estimator: np.ndarray
     angles: Grid
     local_rows: list
+    layers: tuple               # optics.LayerIOPs of each kernel layer
 
     def kernel_args(self) -> tuple:
         return (self.medium, self.mf, self.mi, self.surface, self.bottom, self.bp, self.sky,
@@ -68,16 +69,17 @@ def build(config: cfg.SceneConfig) -> Scene:
     med, mf, mi, column = medium.pack(config)
     surf = surface.pack(config.surface, config.n_water)
     bot, bp = bottom.pack(config.bottom)
-    sk, sf = sky.pack(config.illumination)
+    sk, sf = sky.pack(optics.monochromatic_illumination(config))
     # the sky's share of the photons: the wavelengths' mean diffuse fraction (grid.source_q
     # gives each wavelength its own)
     sk[0]["diffuse_fraction"] = grid.stratified_fraction(optics.illumination_spectrum(config)[1])
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]), column.max_comps)
+                                   len(directions[0]), len(column.albedo), column.max_comps)
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
-                 pack_estimator(config.estimator, column.albedo), angles, local_rows)
+                 pack_estimator(config.estimator, column.albedo), angles, local_rows,
+                 column.layers)
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]

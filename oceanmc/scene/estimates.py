@@ -128,7 +128,7 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     tables: dict[bytes, int] = {}
     table_of_layer = []
     moments = {"m0w": [], "m1w": [], "m0a": [], "m1a": []}
-    for layer in range(len(config.water.layers)):
+    for layer in range(len(column.albedo)):
         key = layer_key(medium, mf, mi, layer) if enabled else b""
         if key not in tables:
             tables[key] = len(tables)

@@ -88,21 +88,22 @@ def source_shares(diffuse_fraction: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int, max_comps: int = 1,
+         surface_level: int, n_dirs: int, n_layers: int, max_comps: int = 1,
          bottom_shares: np.ndarray | None = None
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
-    light), then 0+ (water-leaving light); n_dirs local-estimate rows. A spectral scene's row
-    holds the packet's spectral state first (max_comps: phase components of the layer with
-    most), then one block per wavelength; bottom_shares: each wavelength's bottom reflectance
-    relative to the packed BRDF's (default 1)."""
+    light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
+    (a depth profile's sublayers each absorb into a budget column of their own). A spectral
+    scene's row holds the packet's spectral state first (max_comps: phase components of the
+    layer with most), then one block per wavelength; bottom_shares: each wavelength's bottom
+    reflectance relative to the packed BRDF's (default 1)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
     n_levels = n_depths + 2
     radiance_on = bool(config.tallies.radiance)
     theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
-    n_budget = models.BUDGET_LAYERS + len(config.water.layers)
+    n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
     layout = {}
     # the packet's spectral state (m, q per wavelength, then phase-component values)

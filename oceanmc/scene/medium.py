@@ -25,6 +25,8 @@ class Column:
     depths: np.ndarray         # tally depths, snapped onto layer boundaries
     level_tau: np.ndarray      # optical depth of each tally depth
     albedo: np.ndarray         # per layer
+    layers: tuple              # optics.LayerIOPs of each layer (a depth profile is resolved
+    #                            into several layers of one configured layer)
     max_comps: int             # phase-function components in the layer that has most
 
 
@@ -196,5 +198,5 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_start=i.add(comp_start), comp_count=i.add(comp_count),
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
         comp_tab_len=i.add(tab_len))
-    column = Column(surface_level, depths, level_tau, albedo, max(comp_count))
+    column = Column(surface_level, depths, level_tau, albedo, tuple(layers), max(comp_count))
     return rec, f.array(), i.array(), column

@@ -71,11 +71,17 @@ def single_blas_thread():
 
 
 def _solve(tau, w0, g, mu0, rho, nquad):
+    """g: Henyey-Greenstein's asymmetry, or the Legendre moments chi_l (chi_0 = 1) of another
+    phase function (delta-M truncation f = chi_nquad when positive)."""
     from PythonicDISORT import pydisort, subroutines
     nleg_all = 600
-    leg = np.asarray(g, dtype=np.float64) ** np.arange(nleg_all)
+    if np.ndim(g) == 0:
+        leg = np.asarray(g, dtype=np.float64) ** np.arange(nleg_all)
+    else:
+        leg = np.zeros(max(nleg_all, nquad + 1))
+        leg[:min(len(g), len(leg))] = np.asarray(g, dtype=np.float64)[:len(leg)]
     nleg = nquad
-    f = float(leg[nleg]) if g > 0.0 else 0.0
+    f = float(leg[nleg]) if leg[nleg] > 1e-12 else 0.0
     kwargs = dict(NLeg=nleg, NFourier=min(nquad, 64), f_arr=f, NT_cor=f > 0.0)
     if rho > 0.0:
         kwargs["BDRF_Fourier_modes"] = [float(rho)]
@@ -111,7 +117,8 @@ def slab(tau: float, w0: float, g: float, sun_zenith_deg: float, rho: float,
          tau_levels, theta_edges, phi_edges, is_cap, mu_cut: float, nquad: int = 128,
          n_mu: int = N_MU_NODES, n_phi: int = N_PHI_NODES) -> dict:
     """Fluxes and quad-averaged radiances (oceanmc grid) of a homogeneous slab from DISORT.
-    Returns Ed, Eu (levels) and radiance (levels, theta, phi), all per unit Ed(0+)."""
+    Returns Ed, Eu (levels) and radiance (levels, theta, phi), all per unit Ed(0+). g: HG's
+    asymmetry or a phase function's Legendre moments (_solve)."""
     mu0 = math.cos(math.radians(sun_zenith_deg))
     fp, fm, ui = _solve(tau, w0, g, mu0, rho, nquad)
     levels = np.asarray(tau_levels, dtype=np.float64)

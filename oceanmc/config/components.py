@@ -1,0 +1,138 @@
+"""Water described by its constituents: a layer's `components:` (each adds absorption, scattering
+and a phase function per wavelength; oceanmc/optics/components/ has one module per model) and the
+depth profiles a component's amount may follow (oceanmc/optics/profiles.py)."""
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import AliasChoices, Discriminator, Field, Tag, model_validator
+
+from .base import NonNegative, _Strict
+from .phase import BasicPhase
+from .wavelengths import BackscatterRatio, Spectral, spectral
+
+Depth = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+
+
+class GaussianProfile(_Strict):
+    """background + integral / (width sqrt(2 pi)) exp(-(z - peak_depth)^2 / (2 width^2)), z the
+    depth below the surface (m); integral is the whole peak's column amount (e.g. mg/m2 for
+    chlorophyll; the share of a peak near the surface that lies above z = 0 is not in the
+    water), also accepted as total_mg_m2."""
+    profile: Literal["gaussian"]
+    background: NonNegative
+    peak_depth_m: Depth
+    width_m: Positive
+    integral: NonNegative = Field(validation_alias=AliasChoices("integral", "total_mg_m2"))
+
+
+class LinearProfile(_Strict):
+    """Piecewise linear through (depths_m, values), held at the end values above the first depth
+    and below the last."""
+    profile: Literal["linear"]
+    depths_m: Annotated[list[Depth], Field(min_length=2)]
+    values: Annotated[list[NonNegative], Field(min_length=2)]
+
+    @model_validator(mode="after")
+    def _matching(self) -> "LinearProfile":
+        if len(self.values) != len(self.depths_m):
+            raise ValueError(f"values has {len(self.values)} entries and depths_m "
+                             f"{len(self.depths_m)}; give one value per depth")
+        if any(b <= a for a, b in zip(self.depths_m, self.depths_m[1:])):
+            raise ValueError(f"depths_m = {self.depths_m}: must be strictly increasing")
+        return self
+
+
+class TableProfile(_Strict):
+    """A CSV (or whitespace) file of depth_m, value rows; piecewise linear between them and held
+    at the end values outside."""
+    profile: Literal["table"]
+    file: str
+
+
+Profile = Annotated[Union[GaussianProfile, LinearProfile, TableProfile],
+                    Field(discriminator="profile")]
+
+
+def _amount_kind(value) -> str:
+    return "profile" if isinstance(value, (dict, GaussianProfile, LinearProfile, TableProfile)) \
+        else "amount_value"
+
+
+# a component's amount: one number, or a profile over depth
+Amount = Annotated[Union[Annotated[NonNegative, Tag("amount_value")],
+                         Annotated[Profile, Tag("profile")]],
+                   Discriminator(_amount_kind)]
+
+
+class PureWaterComponent(_Strict):
+    """a_w: Pope & Fry (1997), 380-727.5 nm; Smith & Baker (1981) outside it (200-800 nm).
+    b_w: pure sea water, Morel (1974), 0.00288 (lambda/500)^-4.32; phase 0.06225 (1 + 0.835
+    cos^2)."""
+    model: Literal["pure_water"]
+
+
+class ChlorophyllComponent(_Strict):
+    """Case-1 phytoplankton and the particles that covary with them: a_ph = A_phi Chl^E_phi
+    (Bricaud et al. 1998, 400-700 nm); b_p and bb_p of Morel & Maritorena (2001) with the
+    spectral exponent of Morel et al. (2002); Fournier-Forand phase by bb_p/b_p."""
+    model: Literal["chlorophyll"]
+    chl_mg_m3: Amount
+
+
+class CdomComponent(_Strict):
+    """Coloured dissolved organic matter: a_g = a440 exp(-slope (lambda - 440)); no scattering."""
+    model: Literal["cdom"]
+    a440: Amount
+    slope: Annotated[float, Field(ge=0.0, le=0.1, allow_inf_nan=False)] = 0.014
+
+
+class ParticlesComponent(_Strict):
+    """Non-algal particles / minerals: a = a443 exp(-slope (lambda - 443)), b = b550 (550 /
+    lambda)^exponent, Fournier-Forand phase with backscatter fraction bb_ratio. concentration
+    (default 1) scales a and b together and may follow a depth profile."""
+    model: Literal["particles"]
+    b550: NonNegative
+    exponent: Annotated[float, Field(ge=-1.0, le=4.0, allow_inf_nan=False)] = 1.0
+    bb_ratio: BackscatterRatio = 0.0183
+    a443: NonNegative = 0.0
+    slope: Annotated[float, Field(ge=0.0, le=0.1, allow_inf_nan=False)] = 0.011
+    concentration: Amount = 1.0
+
+
+class TableComponent(_Strict):
+    """Measured IOPs from a CSV: columns wavelength_nm, a, b, bb_ratio (a and b in 1/m),
+    linearly interpolated; Fournier-Forand phase by bb_ratio."""
+    model: Literal["table"]
+    file: str
+
+
+class ConstantComponent(_Strict):
+    """a, b (1/m; one number or one per wavelength) and the phase function (or bb_ratio, which
+    makes it Fournier-Forand), as a layer without components has them. concentration (default
+    1) scales a and b and may follow a depth profile."""
+    model: Literal["constant"]
+    a: Spectral
+    b: Spectral = 0.0
+    phase: BasicPhase | None = None
+    bb_ratio: spectral(BackscatterRatio) | None = None
+    concentration: Amount = 1.0
+
+    @model_validator(mode="after")
+    def _one_phase(self) -> "ConstantComponent":
+        if self.bb_ratio is not None and self.phase is not None:
+            raise ValueError("bb_ratio and phase both given: bb_ratio makes the phase function "
+                             "Fournier-Forand with that backscatter fraction; give one")
+        return self
+
+
+Component = Annotated[
+    Union[PureWaterComponent, ChlorophyllComponent, CdomComponent, ParticlesComponent,
+          TableComponent, ConstantComponent],
+    Field(discriminator="model"),
+]
+
+# the keys of each model whose value may be a depth profile
+PROFILE_KEYS = {"pure_water": (), "chlorophyll": ("chl_mg_m3",), "cdom": ("a440",),
+                "particles": ("concentration",), "table": (), "constant": ("concentration",)}

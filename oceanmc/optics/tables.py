@@ -1,0 +1,58 @@
+"""Spectral tables: the published ones shipped in oceanmc/data (each file's header cites its
+source) and users' CSVs, read once and interpolated linearly in wavelength. A wavelength outside a
+table's range is a ConfigError naming the key, the table and its range."""
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..config import ConfigError
+
+
+@lru_cache(maxsize=None)
+def read_csv(path: str) -> dict[str, np.ndarray]:
+    """The columns of a CSV with '#' comment lines and one header line of column names."""
+    try:
+        lines = Path(path).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read it ({exc})") from None
+    rows = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
+    if len(rows) < 2:
+        raise ConfigError(f"{path}: needs a header line of column names and at least one row")
+    names = [n.strip() for n in rows[0].split(",")]
+    try:
+        data = np.array([[float(x) for x in row.split(",")] for row in rows[1:]])
+    except ValueError:
+        raise ConfigError(f"{path}: every row after the header must be {len(names)} numbers "
+                          "separated by commas") from None
+    if data.ndim != 2 or data.shape[1] != len(names):
+        raise ConfigError(f"{path}: every row must have {len(names)} values ({', '.join(names)})")
+    return {name: data[:, k] for k, name in enumerate(names)}
+
+
+@lru_cache(maxsize=None)
+def packaged(name: str) -> dict[str, np.ndarray]:
+    """A table shipped in oceanmc/data."""
+    return read_csv(str(resources.files("oceanmc") / "data" / name))
+
+
+def columns(table: dict[str, np.ndarray], needed: tuple[str, ...], where: str,
+            path: str) -> None:
+    """One line naming the missing columns of a user's table."""
+    missing = [c for c in needed if c not in table]
+    if missing:
+        raise ConfigError(f"{where}: {path} lacks the column(s) {', '.join(missing)}; needed: "
+                          f"{', '.join(needed)} (found: {', '.join(table)})")
+
+
+def interpolate(wavelengths: np.ndarray, nodes: np.ndarray, values: np.ndarray, where: str,
+                what: str) -> np.ndarray:
+    """Linear interpolation; every wavelength must lie within the table's nodes."""
+    outside = (wavelengths < nodes[0]) | (wavelengths > nodes[-1])
+    if outside.any():
+        raise ConfigError(f"{where}: wavelength {wavelengths[outside][0]:g} nm is outside the "
+                          f"{what} table's range {nodes[0]:g}-{nodes[-1]:g} nm")
+    return np.interp(wavelengths, nodes, values)
