@@ -120,14 +120,24 @@ def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
     them); beam: the packet is still part of the collimated solar beam."""
     w_over_mu = w * inverse_mu(uz, grid.mu_cut, beam)
     at = grid.flux + 4 * level
-    if uz > 0.0:
-        score(grid, tally, at + FLUX_ED, w)
-        score(grid, tally, at + FLUX_EOD, w_over_mu)
-    else:
-        score(grid, tally, at + FLUX_EU, w)
-        score(grid, tally, at + FLUX_EOU, w_over_mu)
+    plane = at + (FLUX_ED if uz > 0.0 else FLUX_EU)
+    scalar = at + (FLUX_EOD if uz > 0.0 else FLUX_EOU)
+    quad = -1
     if grid.radiance_on:
         band = theta_band_fast(grid, gf, gi, uz)
         col = 0 if gi[grid.theta_is_cap + band] else phi_band_fast(grid, gf, ux, uy)
-        score(grid, tally, grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col,
-              w_over_mu)
+        quad = grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col
+    if grid.n_wl == 1:
+        tally[plane] += w
+        tally[scalar] += w_over_mu
+        if quad >= 0:
+            tally[quad] += w_over_mu
+        return
+    q = grid.spectral + grid.n_wl
+    for j in range(grid.n_wl):
+        block = j * grid.wl_stride
+        share = tally[q + j]
+        tally[plane + block] += w * share
+        tally[scalar + block] += w_over_mu * share
+        if quad >= 0:
+            tally[quad + block] += w_over_mu * share
