@@ -243,6 +243,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
 
+    if args.spectral:
+        from .bench import spectral
+        return spectral.main(Path(args.output), args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -303,6 +307,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("-o", "--output", default="benchmarks", metavar="DIR",
                        help="report folder (default: benchmarks)")
     bench.add_argument("--quick", action="store_true", help="small counts: a smoke test")
+    bench.add_argument("--spectral", action="store_true",
+                       help="only the spectral section (one history against 31 runs): "
+                            "DIR/spectral.md")
     bench.add_argument("--configs", default="configs", metavar="DIR",
                        help="folder with the benchmark scenes (default: configs)")
     bench.add_argument("--bare-walk", metavar="PATH",
