@@ -44,12 +44,12 @@ def single(config: dict, k: int, seed: int) -> dict:
     return out
 
 
-def compare_with_singles(config: dict) -> None:
+def compare_with_singles(config: dict, compared=COMPARED) -> None:
     spectral = oceanmc.simulate(config, threads=THREADS)
     singles = [oceanmc.simulate(single(config, k, 100 + k), threads=THREADS)
                for k in range(len(config["wavelengths_nm"]))]
-    n_compared = sum(spectral[name].size for name in COMPARED)
-    for name in COMPARED:
+    n_compared = sum(spectral[name].size for name in compared)
+    for name in compared:
         reference = np.stack([s[name][0] for s in singles])
         ref_se = np.stack([s.stderr(name)[0] for s in singles])
         assert_z(spectral[name], reference, np.hypot(spectral.stderr(name), ref_se),
@@ -70,13 +70,7 @@ def test_one_history_matches_single_wavelength_runs_deep_turbid():
                                   "b": [3.0, 2.6, 2.2], "bb_ratio": 0.018}]
     config["bottom"] = {"model": "none"}
     config["tallies"]["depths_m"] = [0, 1, 3]
-    global COMPARED
-    saved = COMPARED
-    COMPARED = tuple(n for n in saved if n != "budget/absorbed_bottom")
-    try:
-        compare_with_singles(config)
-    finally:
-        COMPARED = saved
+    compare_with_singles(config, tuple(n for n in COMPARED if n != "budget/absorbed_bottom"))
 
 
 def test_spectral_illumination_sun_and_sky_shares(tmp_path):
