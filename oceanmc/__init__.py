@@ -5,6 +5,7 @@
     result = oceanmc.simulate(config)
     result["Ed"], result.stderr("Ed")
     result.save("out.h5"); oceanmc.load_result("out.h5")
+    lut = oceanmc.sweep("lut.yaml", "lut.nc", workers=2)      # an xarray.Dataset
 
 The names below are imported on first use (PEP 562), so that `import oceanmc` and commands that
 need little (`oceanmc --help`) do not pay for numba, h5py and pydantic.
@@ -22,11 +23,12 @@ _LAZY = {
     "load_result": "run.hdf5",
     "simulate": "run.simulation",
 }
-# the subpackages, as attributes (the data flow: config -> scene -> kernel -> run)
-_SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run"})
+# the subpackages, as attributes (the data flow: config -> scene -> kernel -> run); `sweep` is
+# also the function oceanmc.sweep(...) (the package is callable, see sweep/__init__.py)
+_SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run", "sweep"})
 
 __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result", "simulate",
-           "__version__"]
+           "sweep", "__version__"]
 
 if TYPE_CHECKING:
     from .config import ConfigError, SceneConfig, load_config

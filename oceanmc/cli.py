@@ -1,4 +1,5 @@
-"""The `oceanmc` command: run scenes, validate the physics, show and plot results files.
+"""The `oceanmc` command: run scenes, sweep them, validate the physics, show and plot results
+files.
 
 Exit status: 0 success, 1 a failed validation or a run that could not finish, 2 bad input (a
 config, a path, an option), 130 interrupted.
@@ -234,6 +235,52 @@ def cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from .sweep import SweepError, sweep
+
+    source = Path(args.sweep)
+    out = Path(args.output) if args.output else Path("results") / f"{source.stem}.nc"
+    if not source.is_file():
+        raise UsageError(f"{source}: no such file")
+    if out.suffix != ".nc":
+        raise UsageError(f"-o {out}: a sweep writes a NetCDF file; name it *.nc")
+    _check_writable(out, overwrite=True)
+    if out.exists() and not args.overwrite and not _is_sweep_dataset(out):
+        raise UsageError(f"{out} exists and is not an oceanmc sweep dataset; pass --overwrite "
+                         "to replace it")
+    try:
+        lut = sweep(source, out, workers=args.workers, scheduler=args.scheduler,
+                    threads=args.threads, batch_groups=args.batch_groups,
+                    workers_write=True if args.workers_write else None, progress=not args.quiet,
+                    log=lambda text: print(f"oceanmc: sweep: {text}", file=sys.stderr,
+                                           flush=True))
+    except SweepError as exc:
+        print(f"oceanmc: config error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"oceanmc: sweep interrupted: wrote {out} with the points done so far (status "
+              f"'pending' for the others); the same command finishes it", file=sys.stderr)
+        return 130
+    a = lut.attrs
+    print(f"{a['points_done']} of {a['points']} points done, {a['points_failed']} failed; "
+          f"wrote {out} (finished points are kept in {out.with_suffix('.points')}/)")
+    failed = lut["status"].values == "failed"
+    for index in zip(*failed.nonzero()):
+        where = ", ".join(f"{dim} = {lut[dim].values[i]}" for dim, i in zip(lut.attrs["axes"]
+                                                                        .split(","), index))
+        print(f"  failed ({where}): {lut['error'].values[index]}")
+    return 1 if a["points_failed"] else 0
+
+
+def _is_sweep_dataset(path: Path) -> bool:
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            return f.attrs.get("title") in ("oceanmc sweep", b"oceanmc sweep")
+    except OSError:
+        return False
+
+
 def cmd_validate(args: argparse.Namespace) -> int:
     from . import validation
 
@@ -247,6 +294,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from .bench import spectral
         return spectral.main(Path(args.output), args.quick)
 
+    if args.sweep:
+        from .bench import sweep
+        return sweep.main(Path(args.output), quick=args.quick)
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -296,6 +346,31 @@ def build_parser() -> argparse.ArgumentParser:
     merge.add_argument("--overwrite", action="store_true", help="replace an existing OUT.h5")
     merge.set_defaults(func=cmd_merge)
 
+    sweep = sub.add_parser("sweep", help="a look-up table: one scene over axes of its keys, "
+                                         "on Dask; one NetCDF dataset")
+    sweep.add_argument("sweep", metavar="SWEEP.yaml",
+                       help="base scene and axes (README: Sweeps)")
+    sweep.add_argument("-o", "--output", metavar="LUT.nc",
+                       help="the dataset (default: results/<sweep name>.nc)")
+    where = sweep.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_positive_int,
+                       help="worker processes of a local Dask cluster (default: one per core)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                       help="an existing Dask scheduler to run the points on")
+    sweep.add_argument("--threads", type=_positive_int,
+                       help="threads per point (default: the cores shared among local workers; "
+                            "with --scheduler, the worker's cores)")
+    sweep.add_argument("--batch-groups", type=_positive_int, metavar="N",
+                       help="spread each point's batches over N tasks (merged exactly; "
+                            "overrides the sweep file's batch_groups)")
+    sweep.add_argument("--workers-write", action="store_true",
+                       help="with --scheduler: the workers see the output folder (a shared file "
+                            "system) and write each point's file themselves")
+    sweep.add_argument("--overwrite", action="store_true",
+                       help="replace an output file that is not an oceanmc sweep dataset")
+    sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    sweep.set_defaults(func=cmd_sweep)
+
     validate = sub.add_parser("validate", help="run the validation suite and write its report")
     validate.add_argument("-o", "--output", default="validation", metavar="DIR",
                           help="report folder (default: validation)")
@@ -310,6 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--spectral", action="store_true",
                        help="only the spectral section (one history against 31 runs): "
                             "DIR/spectral.md")
+    bench.add_argument("--sweep", action="store_true",
+                       help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
+                            "and 2 Dask workers against a plain loop")
     bench.add_argument("--configs", default="configs", metavar="DIR",
                        help="folder with the benchmark scenes (default: configs)")
     bench.add_argument("--bare-walk", metavar="PATH",

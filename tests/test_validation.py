@@ -95,3 +95,76 @@ def test_jackknife_matches_the_batch_standard_error():
     ratio = est[0] / est[1]
     assert ratio.value == pytest.approx(x[:, 0].mean() / x[:, 1].mean())
     assert z_tolerance(1, 64) == 4.0 and z_tolerance(400, 64) > 4.0
+
+
+def test_group_summaries_hold_their_false_alarm_rate():
+    """chi2_z and hotelling_z of groups of Student-t z (32 batches, normal batch values) exceed
+    the normal quantile of p with probability close to p; the standardised sum of z^2 they
+    replace exceeded 4 (p = 3e-5 for a normal z) about 50 times too often for 8 members."""
+    from scipy import stats as st
+    from oceanmc.validation.stats import chi2_z, hotelling_z
+    rng = np.random.default_rng(7)
+    n_batches, trials, p = 32, 4000, 0.01
+    bound = st.norm.isf(p)
+    for members in (3, 8, 54):
+        x = rng.normal(size=(trials, n_batches, members))
+        z = x.mean(axis=1) / (x.std(axis=1, ddof=1) / math.sqrt(n_batches))
+        rate = np.mean([chi2_z(zz, n_batches) > bound for zz in z])
+        assert abs(rate - p) < 4 * math.sqrt(p / trials), (members, rate)
+    hz = [hotelling_z(b.mean(axis=0), JK.from_batches(b).loo) for b in x[:2000, :, :8]]
+    rate = np.mean(np.array(hz) > bound)
+    assert abs(rate - p) < 4 * math.sqrt(p / 2000), rate
+
+
+def test_hotelling_of_proportional_estimates_has_their_rank():
+    """Eight estimates that are fixed multiples of one (local estimates of an isotropic radiance
+    in eight directions score the same events) are one test with one degree of freedom: their
+    Hotelling z equals that of the single estimate, whatever the rounding of the copies."""
+    from scipy import stats as st
+    from oceanmc.validation.stats import hotelling_z
+    rng = np.random.default_rng(3)
+    x = 1.0 + 0.1 * rng.normal(size=32)
+    scale = np.linspace(1.0, 2.0, 8)
+    est = JK.from_batches(x[:, None] * scale[None, :])
+    one = JK.from_batches(x)
+    diff = est.value - 0.99 * scale
+    z1 = float((one.value - 0.99) / one.stderr)
+    expected = st.norm.isf(st.f.sf(z1 * z1, 1, 31))
+    assert hotelling_z(diff, est.loo, ref_error=1e-9 * scale) == pytest.approx(expected, rel=1e-6)
+    assert hotelling_z(diff, est.loo) == pytest.approx(expected, rel=1e-6)
+
+
+def test_case_bounds_are_bonferroni_over_the_case():
+    """After run_case, the bounds of a case's checks split the family-wise false alarm
+    FAMILY_ALPHA over all its statistical checks: the members of groups get t quantiles for
+    their count, the single quantities and summaries theirs."""
+    from scipy import stats as st
+    from oceanmc.validation.stats import FAMILY_ALPHA
+    outcome = v.run_case("chandrasekhar", quick=True)
+    stat = [c for c in outcome.ctx.checks if c.kind in ("z", "chi2")]
+    members = [c for c in stat if c.kind == "z" and c.group]
+    heads = [c for c in stat if c not in members]
+    assert members and heads
+    share = FAMILY_ALPHA / 2
+    for c in members:
+        assert c.tolerance == pytest.approx(max(4.0, st.t.isf(share / 2 / len(members),
+                                                              c.n_batches - 1)))
+    for c in heads:
+        assert c.tolerance == pytest.approx(max(4.0, st.t.isf(share / 2 / len(heads), c.n_batches
+                                                              - 1) if c.kind == "z"
+                                                else st.norm.isf(share / len(heads))))
+    assert outcome.passed, [c.quantity for c in stat if not c.passed][:5]
+
+
+@pytest.mark.parametrize("factor", [1.05, 0.95])
+def test_a_five_percent_error_in_a_reference_fails_its_case(monkeypatch, factor):
+    """The wider per-check bounds keep their power: Chandrasekhar's reflected radiance off by
+    5% fails the case (the quads' and bands' summaries and the local estimates)."""
+    true_radiance = ref.chandrasekhar_radiance
+    monkeypatch.setattr(ref, "chandrasekhar_radiance",
+                        lambda *a, **k: factor * true_radiance(*a, **k))
+    outcome = v.run_case("chandrasekhar", quick=True)
+    failing = [c for c in outcome.ctx.checks if not c.passed]
+    assert not outcome.passed
+    assert any("quad reflected radiance [" in c.quantity for c in failing)
+    assert any("exact directions" in c.quantity for c in failing)

@@ -92,10 +92,12 @@ def _describe(error: dict) -> str:
     return f"{path}: {msg}"
 
 
-def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] | None = None
-                ) -> SceneConfig:
+def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] | None = None,
+                *, base_dir: str | Path | None = None) -> SceneConfig:
     """Reads a scene from a YAML file path or a dict, applies top-level overrides (photons, seed),
-    and returns the validated SceneConfig. Raises ConfigError with one clear message."""
+    and returns the validated SceneConfig. Raises ConfigError with one clear message. Table files
+    named in a dict are relative to base_dir (default: the current folder); a sweep's points
+    are dicts made from a YAML file, whose folder they keep."""
     origin = "config"
     if isinstance(source, (str, Path)):
         path = Path(source)
@@ -116,7 +118,7 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
         base_dir = path.parent
     elif isinstance(source, dict):
         data = source
-        base_dir = Path.cwd()
+        base_dir = Path.cwd() if base_dir is None else Path(base_dir)
     else:
         raise ConfigError(f"{origin}: expected a YAML file path or a mapping, got "
                           f"{type(source).__name__}")

@@ -71,6 +71,7 @@ def run_case(name: str, quick: bool = True, override: dict | None = None,
     error = None
     try:
         case.run(ctx)
+        ctx.finalize()
     except Exception:   # a crashing case is a failing case, and the others still run
         error = traceback.format_exc()
         ctx.checks.append(Check(case.name, "case ran to completion", 0.0, None, 1.0, None, 0.0,

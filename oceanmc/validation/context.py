@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ..plot import close, save
-from .stats import JK, MIN_Z_TOL, chi2_z, hotelling_z, z_score, z_tolerance
+from .stats import (FAMILY_ALPHA, JK, MIN_Z_TOL, chi2_z, hotelling_z, summary_tolerance, z_score,
+                    z_tolerance)
 
 
 @dataclass
@@ -32,6 +33,8 @@ class Check:
     rel_stderr: float | None = None
     rel_stderr_cap: float | None = None
     note: str = ""
+    n_batches: int | None = None    # z checks: the batches behind the standard error
+    other_ok: bool = True           # everything but the z bound (precision cap, finite members)
 
     def record(self) -> dict:
         def num(x):
@@ -117,10 +120,11 @@ class Ctx:
                 n_batches: int | None = None, note: str = "", counts=None,
                 min_count: float = 10.0, loo=None) -> list[Check]:
         """z-score checks of estimates against references. A single quantity must have
-        |z| <= 4 (and stderr/|reference| <= rel_cap when given). A group of N quantities uses the
-        Bonferroni-corrected Student-t bound for each member, and gets a summary record: the
-        standardised sum of z^2 (one-sided, <= 4) with the median relative standard error, which
-        must not exceed rel_cap. With the members' leave-one-batch-out replicates (loo, batch
+        |z| within its bound (and stderr/|reference| <= rel_cap when given). A group of N
+        quantities gets a bound for each member and a summary record: the chi-square of the
+        members' z as a one-sided normal z, with the median relative standard error, which must
+        not exceed rel_cap. The bounds set here are the group's own (Bonferroni over its members);
+        finalize() then sets them for the whole case. With the members' leave-one-batch-out replicates (loo, batch
         axis first) and few enough members, the summary is Hotelling's T^2 with their estimated
         covariance instead (members of one run, e.g. depths, are correlated). counts (optional):
         the expected number of photons per batch that score each member; members below
@@ -163,7 +167,7 @@ class Ctx:
             name = f"{quantity} {labels[i]}".strip()
             out.append(self._add(Check(self.case, name, value[i], stderr[i], reference[i], z[i],
                                        tol, passed, "z", grp, ref_error[i], rel_err[i],
-                                       rel_se[i], cap, note)))
+                                       rel_se[i], cap, note, nb, bool(cap_ok))))
         if n > 1:
             hz = None
             if loo is not None:
@@ -182,10 +186,31 @@ class Ctx:
                     rel_err)) else None, med, rel_cap,
                 ("value: mean z^2; reference: its expectation for Student-t z; z: Hotelling's "
                  "T^2 with the batch covariance as a one-sided normal z" if hz is not None else
-                 "value: mean z^2; reference: its expectation for Student-t z; z: standardised "
-                 "sum of z^2 (one-sided)") + "; rel_stderr: median over the group"
-                + (f"; {note}" if note else ""))))
+                 "value: mean z^2; reference: its expectation for Student-t z; z: the "
+                 "chi-square of the members' normal equivalents as a one-sided normal z")
+                + "; rel_stderr: median over the group"
+                + (f"; {note}" if note else ""), None, bool(finite and cap_ok))))
         return out
+
+    def finalize(self, alpha: float = FAMILY_ALPHA) -> None:
+        """Sets every statistical check's bound so that the whole case raises a false alarm with
+        probability at most alpha (Bonferroni): half of alpha over the members of groups (Student
+        t bounds), half over the single quantities and the groups' summaries (which carry the
+        power against a bias spread over a group); all of it to one kind if the other is absent.
+        run_case calls it once the case has run; before, each group has its own bound (stricter)."""
+        stat = [c for c in self.checks if c.kind in ("z", "chi2")]
+        members = [c for c in stat if c.kind == "z" and c.group]
+        heads = [c for c in stat if not (c.kind == "z" and c.group)]
+        share = alpha / 2.0 if members and heads else alpha
+        for c in members:
+            c.tolerance = z_tolerance(len(members), c.n_batches or self.batches, share)
+        for c in heads:
+            c.tolerance = (z_tolerance(len(heads), c.n_batches or self.batches, share)
+                           if c.kind == "z" else summary_tolerance(len(heads), share))
+        for c in stat:
+            within = c.z is not None and math.isfinite(c.z) and (
+                abs(c.z) <= c.tolerance if c.kind == "z" else c.z <= c.tolerance)
+            c.passed = bool(within and c.other_ok)
 
     def compare_jk(self, quantity: str, est: JK, reference, **kw) -> list[Check]:
         return self.compare(quantity, est.value, est.stderr, reference, n_batches=est.n,

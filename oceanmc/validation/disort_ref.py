@@ -189,12 +189,19 @@ def point_radiance(tau, w0, g, sun_zenith_deg, rho, tau_levels, mu_travel, phi_r
     mu_d = -np.asarray(mu_travel, dtype=np.float64)        # DISORT: mu > 0 upward
     phi = np.asarray(phi_rad, dtype=np.float64)
     out = np.empty((len(tau_levels), len(mu_d)))
+    # Straight up or down the radiance has no azimuth, and every Fourier mode m >= 1 vanishes
+    # (it carries P_l^m(mu), zero at |mu| = 1); PythonicDISORT's interpolated modes do not (at
+    # tau 2, w0 0.5, g 0.5, sun 40, Lambertian 0.8 the zenith value at phi = 0 came out 0.28% high,
+    # 0.09% apart between 96 and 128 streams). There the azimuthal mean over 2 n_fourier azimuths,
+    # which keeps the m = 0 mode only, is taken instead.
+    polar_azimuths = np.linspace(0.0, 2.0 * math.pi, 2 * min(nquad, 64), endpoint=False)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for k, (m, p) in enumerate(zip(mu_d, phi)):
+            polar = abs(abs(m) - 1.0) < 1e-12
             v = np.asarray(ui(np.array([m]), np.asarray(tau_levels, dtype=np.float64),
-                              np.array([p])))
-            out[:, k] = v.reshape(-1)
+                              polar_azimuths if polar else np.array([p])))
+            out[:, k] = v.reshape(len(tau_levels), -1).mean(axis=1)
     return out
 
 

@@ -14,7 +14,8 @@ import math
 import numpy as np
 from scipy import stats as _st
 
-FAMILY_ALPHA = 1e-3   # false-alarm probability allowed for a group of compared quantities
+FAMILY_ALPHA = 1e-3   # false-alarm probability allowed for a whole validation case (all its
+                      # statistical checks together: Bonferroni over them, see Ctx.finalize)
 MIN_Z_TOL = 4.0       # never accept less than |z| < 4 (DESIGN.md section 5)
 
 
@@ -123,52 +124,89 @@ class JK:
         return JK(fn(self.value), np.stack([fn(x) for x in self.loo]))
 
 
-def z_tolerance(n_compared: int, n_batches: int) -> float:
-    """|z| bound for one of n_compared quantities: Bonferroni over the group at FAMILY_ALPHA with
-    Student's t (batches - 1 degrees of freedom, since the standard error is estimated from the
-    batches), and never below MIN_Z_TOL."""
+def z_tolerance(n_compared: int, n_batches: int, alpha: float = FAMILY_ALPHA) -> float:
+    """|z| bound for one of n_compared quantities: Bonferroni over them at the family-wise
+    two-sided false-alarm probability alpha, with Student's t (batches - 1 degrees of freedom,
+    since the standard error is estimated from the batches), and never below MIN_Z_TOL."""
     df = max(n_batches - 1, 2)
-    tail = FAMILY_ALPHA / (2.0 * max(n_compared, 1))
+    tail = alpha / (2.0 * max(n_compared, 1))
     return max(MIN_Z_TOL, float(_st.t.isf(tail, df)))
 
 
+def summary_tolerance(n_summaries: int, alpha: float = FAMILY_ALPHA) -> float:
+    """Bound for one of n_summaries one-sided normal z (group summaries: chi2_z, hotelling_z):
+    Bonferroni at the family-wise false-alarm probability alpha, never below MIN_Z_TOL."""
+    return max(MIN_Z_TOL, float(_st.norm.isf(alpha / max(n_summaries, 1))))
+
+
+def normal_equivalent(z: np.ndarray, n_batches: int) -> np.ndarray:
+    """The standard normal deviate with the same tail probability as a Student-t z of
+    batches - 1 degrees of freedom (a z over a batch standard error of few batches is t
+    distributed, with heavier tails than the normal)."""
+    z = np.asarray(z, dtype=np.float64)
+    df = max(n_batches - 1, 2)
+    # the upper tail of |z|, mapped through the normal's (isf keeps precision far out)
+    return np.sign(z) * _st.norm.isf(_st.t.sf(np.abs(z), df))
+
+
 def chi2_z(z: np.ndarray, n_batches: int) -> float:
-    """The sum of squared z-scores of a group, standardised: for t-distributed z with nu = batches
-    - 1 degrees of freedom E[t^2] = nu/(nu-2) and Var[t^2] = 2 nu^2 (nu-1)/((nu-2)^2 (nu-4)).
-    Large positive values mean the estimates scatter about the references more than their errors
-    allow (a bias spread thinly over many bins)."""
+    """Joint test of a group of independent z-scores: each Student-t z (nu = batches - 1) is
+    mapped to its normal equivalent, whose squares sum to a chi-square of N degrees of freedom;
+    its upper tail probability is returned as a one-sided normal z. Large positive values mean
+    the estimates scatter about the references more than their errors allow (a bias spread
+    thinly over many bins). Exact for independent t members, where the standardised sum of z^2
+    (a normal approximation) had a heavy right tail for small groups."""
     z = np.asarray(z, dtype=np.float64)
     z = z[np.isfinite(z)]
     if z.size == 0:
         return 0.0
-    nu = max(n_batches - 1, 5)
-    mean = nu / (nu - 2.0)
-    var = 2.0 * nu * nu * (nu - 1.0) / ((nu - 2.0) ** 2 * (nu - 4.0))
-    return float((np.sum(z * z) - z.size * mean) / math.sqrt(z.size * var))
+    q = float(np.sum(normal_equivalent(z, n_batches) ** 2))
+    return float(_st.norm.isf(max(float(_st.chi2.sf(q, z.size)), 1e-300)))
+
+
+RANK_RTOL = 1e-9   # eigenvalues of the correlation matrix below this are taken as exactly zero
 
 
 def hotelling_z(diff: np.ndarray, loo: np.ndarray, ref_error=None) -> float | None:
     """Joint test of a group of correlated estimates (e.g. Ed at several depths from the same
     photons): Hotelling's T^2 = d' S^-1 d with S the jackknife covariance of the estimates (plus
-    the references' own variances), converted through F(N, B - N) to a one-sided normal z.
-    None when there are too few batches for a stable covariance (N > B/2)."""
+    the references' own variances), converted through F(r, B - r) to a one-sided normal z, r the
+    rank of the batch covariance. Estimates that are exact multiples of one another (the local
+    estimates of an isotropic radiance in several directions score the same events) make S
+    singular: the test is then taken in the r independent combinations only (the differences
+    along the null directions carry no batch error and are the references' own business).
+    None when there are too few batches for a stable covariance (r > B/2)."""
     diff = np.asarray(diff, dtype=np.float64).ravel()
     loo = np.asarray(loo, dtype=np.float64).reshape(loo.shape[0], -1)
     b, n = loo.shape
-    if n < 2 or n > b // 2 or not np.all(np.isfinite(diff)):
+    if n < 2 or not np.all(np.isfinite(diff)) or not np.all(np.isfinite(loo)):
         return None
     centred = loo - loo.mean(axis=0)
     cov = (b - 1) / b * centred.T @ centred
+    scale = np.sqrt(np.diag(cov))
+    if not np.all(scale > 0):
+        return None
+    corr = cov / np.outer(scale, scale)
+    lam, vec = np.linalg.eigh(corr)
+    keep = lam > RANK_RTOL * lam.max()
+    r = int(np.sum(keep))
+    if r > b // 2:
+        return None
+    # the kept principal combinations c = V' D^-1 d, their covariance Lambda (+ references')
+    basis = vec[:, keep] / scale[:, None]
+    c = basis.T @ diff
+    cov_c = np.diag(lam[keep])
     if ref_error is not None:
-        cov = cov + np.diag(np.asarray(ref_error, dtype=np.float64).ravel() ** 2)
+        re = np.broadcast_to(np.asarray(ref_error, dtype=np.float64), diff.shape)
+        cov_c = cov_c + basis.T @ np.diag(re ** 2) @ basis
     try:
-        t2 = float(diff @ np.linalg.solve(cov, diff))
+        t2 = float(c @ np.linalg.solve(cov_c, c))
     except np.linalg.LinAlgError:
         return None
     if not math.isfinite(t2) or t2 < 0:
         return None
-    f = t2 * (b - n) / (n * (b - 1))
-    p = float(_st.f.sf(f, n, b - n))
+    f = t2 * (b - r) / (r * (b - 1))
+    p = float(_st.f.sf(f, r, b - r))
     return float(_st.norm.isf(max(p, 1e-300)))
 
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from ..context import Ctx
-from .common import Case
+from .common import Case, _plt
 
 WL = np.array([412.0, 443.0, 490.0, 555.0, 670.0])
 # Pope & Fry (1997) a_w (1/m) as printed (OMLC table, 1/cm x 100) at 490 and 670 nm; at 412 nm
@@ -55,6 +55,29 @@ def case_constituent_iops(ctx: Ctx) -> None:
               0.05 * np.exp(-0.0123 * (WL - 443.0)), rtol=1e-12)
     ctx.exact("particles: b = b550 (550/lambda)^n", p.b, 1.2 * (550.0 / WL) ** 0.5, rtol=1e-12)
     ctx.exact("particles: bb = bb_ratio b", p.bb, 0.019 * p.b, rtol=1e-12)
+    wl = np.arange(400.0, 701.0, 5.0)
+    plt = _plt()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.6))
+    import oceanmc
+    for label, comps in (("pure water", [{"model": "pure_water"}]),
+                         ("Chl 0.1", [{"model": "chlorophyll", "chl_mg_m3": 0.1}]),
+                         ("Chl 1", [{"model": "chlorophyll", "chl_mg_m3": 1.0}]),
+                         ("Chl 10", [{"model": "chlorophyll", "chl_mg_m3": 10.0}]),
+                         ("CDOM a440 0.1", [{"model": "cdom", "a440": 0.1}])):
+        (iop,) = optics.column_iops(oceanmc.load_config({
+            "wavelengths_nm": wl.tolist(), "water": {"layers": [
+                {"thickness_m": math.inf, "components": [{"model": "pure_water"}] + comps
+                 if label != "pure water" else comps}]}, "bottom": {"model": "none"}}))
+        left.semilogy(wl, iop.a, label=label)
+        right.semilogy(wl, iop.bb, label=label)
+    left.set_title("absorption a (1/m), pure water included", fontsize=9)
+    right.set_title("backscattering bb (1/m)", fontsize=9)
+    for ax in (left, right):
+        ax.set_xlabel("wavelength (nm)", fontsize=8)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    ctx.figure(fig, "spectra", "Absorption and backscattering of pure water and of pure water "
+               "with Case-1 chlorophyll (0.1, 1, 10 mg/m3) or CDOM, as oceanmc.optics makes them.")
     ctx.note("Each constituent model evaluated by oceanmc.optics at 412, 443, 490, 555 and "
              "670 nm against its published formula, recomputed here, and the printed table "
              "values (Pope & Fry 1997 a_w; Bricaud et al. 1998 A_phi, E_phi at 490 nm). The "

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..context import Ctx
 from ..stats import JK
-from .common import Case, scene
+from .common import Case, _plt, scene
 
 WL = 490.0
 PEAK, WIDTH, TOTAL, BACKGROUND = 20.0, 5.0, 30.0, 0.1
@@ -69,6 +69,27 @@ def case_profile_layering(ctx: Ctx) -> None:
                     rel_cap=None)
         ctx.exact(f"{name}: relative standard error of the profile run below 3%",
                   float(np.max(ja.stderr / ja.value) < 0.03), 1.0)
+    plt = _plt()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.6))
+    tops = a.iops["layer_top"][:-1] if math.isinf(a.iops["layer_thickness"][-1]) \
+        else a.iops["layer_top"]
+    left.step(a.iops["c"][:len(tops), 0], tops, where="post", label="sublayers (c, 1/m)")
+    fine_c = [fine_layer(STEP * k) for k in range(int(THICKNESS / STEP))]
+    left.step([f["a"] + sum(m["b"] for m in f["phase"]["components"]) for f in fine_c],
+              STEP * np.arange(len(fine_c)), where="post", lw=0.7, label="0.25 m layers")
+    left.invert_yaxis()
+    left.set_xlabel("c (1/m)", fontsize=8)
+    left.set_ylabel("depth (m)", fontsize=8)
+    left.legend(fontsize=7)
+    for name, marker in (("Ed", "o"), ("Eu", "s")):
+        right.errorbar(depths, a[name], yerr=a.stderr(name), fmt=marker, label=f"{name} profile")
+        right.plot(depths, b[name], "-", lw=1, label=f"{name} 0.25 m layers")
+    right.set_yscale("log")
+    right.set_xlabel("depth (m)", fontsize=8)
+    right.legend(fontsize=7)
+    fig.tight_layout()
+    ctx.figure(fig, "profile", "Left: the attenuation of the resolved sublayers and of the "
+               "0.25 m reference layers. Right: Ed and Eu of both runs.")
     ctx.note(f"One 40 m layer of pure water and chlorophyll with a deep maximum (gaussian: "
              f"background {BACKGROUND} mg/m3, peak at {PEAK} m, width {WIDTH} m, "
              f"{TOTAL} mg/m2) over a Lambertian bottom of reflectance 0.2, at {WL:g} nm. "

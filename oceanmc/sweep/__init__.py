@@ -1,0 +1,158 @@
+"""Many scenes at once: a look-up table over any keys of a scene, run on Dask.
+
+    import oceanmc
+    lut = oceanmc.sweep("lut.yaml", "lut.nc", workers=2)   # -> xarray.Dataset
+    lut["air_Rrs_nadir"].sel({"bottom.reflectance": 0.2})
+
+The phases, one module each: axes.py (the sweep file, key paths, the grid of points),
+points.py (each point's scene, validated before any photon runs), execute.py (the points on a
+Dask cluster), dataset.py (per-point results files and the assembled dataset).
+"""
+from __future__ import annotations
+
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from .axes import SweepError, SweepSpec, load_sweep, set_key_path
+from .dataset import PointStore, Summary, assemble, write_dataset
+from .points import Point, build_points, check_scenes
+
+__all__ = ["sweep", "prepare", "SweepError", "SweepSpec", "load_sweep", "set_key_path",
+           "points_folder"]
+
+
+def points_folder(output: Path) -> Path:
+    """Where a dataset's finished points are kept: `LUT.nc` -> `LUT.points/`."""
+    return output.with_suffix(".points")
+
+
+@dataclass
+class Plan:
+    """A validated sweep, ready to run: its points and those an earlier run finished."""
+    spec: SweepSpec
+    points: list[Point]
+    store: PointStore
+    summaries: dict[str, Summary] = field(default_factory=dict)
+    errors: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def todo(self) -> list[Point]:
+        return [p for p in self.points if p.key not in self.summaries]
+
+    def dataset(self):
+        """The dataset of the points done, the store's folder being the record: a worker may
+        have written a point's file before its answer reached this process (a Ctrl-C then)."""
+        for point in self.todo:
+            if point.key not in self.errors:
+                summary = self.store.finished(point)
+                if summary is not None:
+                    self.summaries[point.key] = summary
+        return assemble(self.spec, self.points, self.summaries, self.errors)
+
+
+def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | None = None
+            ) -> Plan:
+    """Reads and validates the sweep (every point's scene, tables included: SweepError naming
+    the point), and finds the points a previous run has finished."""
+    from ..run.compiling import ready
+
+    spec = load_sweep(source)
+    if batch_groups is not None:
+        spec = SweepSpec(spec.base, spec.base_dir, spec.settings, spec.axes, batch_groups)
+    points = build_points(spec)
+    ready()   # compiles here, once, into the disk cache that local workers load from
+    check_scenes(points)
+    store = PointStore(store_folder)
+    plan = Plan(spec, points, store)
+    for point in points:
+        summary = store.finished(point)
+        if summary is not None:
+            plan.summaries[point.key] = summary
+    return plan
+
+
+def run(plan: Plan, client, threads: int | None = None, progress: bool = False,
+        workers_write: bool = False) -> None:
+    """Runs the points not yet done on the client's cluster; each finished point is stored as it
+    arrives (a KeyboardInterrupt leaves the plan with what is done). workers_write: the workers
+    see the output folder and write the points' results files themselves."""
+    from .execute import run_points
+
+    def on_done(point: Point, summary: Summary | None, error: str | None) -> None:
+        if summary is not None:
+            plan.summaries[point.key] = summary
+        else:
+            plan.errors[point.key] = error
+
+    todo = plan.todo
+    if todo:
+        run_points(client, plan.store, todo, plan.spec.batch_groups, threads, on_done, progress,
+                   len(plan.points), len(plan.points) - len(todo), workers_write)
+
+
+def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None, *,
+          workers: int | None = None, scheduler: str | None = None, client=None,
+          threads: int | None = None, batch_groups: int | None = None,
+          workers_write: bool | None = None, progress: bool = False,
+          log: Callable[[str], None] | None = None):
+    """Runs a sweep and returns its xarray Dataset (written to `output`, a .nc file, if given).
+
+    source: a sweep YAML file or a mapping {base: scene file | scene mapping | SceneConfig,
+    axes: {key path: [values], zip: {key path: [values], ...}}, set: {key path: value},
+    batch_groups: N}. The points run on `client` (a distributed.Client), on the scheduler at
+    `scheduler` (tcp://HOST:PORT), or on a local cluster of `workers` processes (default: one
+    per core), `threads` threads each (default: the cores shared among the local workers).
+    Finished points are kept in `<output stem>.points/` (a temporary folder without output):
+    a rerun skips them. workers_write: the workers write the points' files there themselves
+    (they must see that folder: a shared file system; default: only on the local cluster
+    started here), else they send each Result back to be written here. A KeyboardInterrupt
+    writes the points done so far (status `pending` for the rest) and is raised again.
+    log(text) receives a line on what is about to run."""
+    import os
+
+    with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:
+        folder = points_folder(Path(output)) if output is not None else Path(scratch)
+        plan = prepare(source, folder, batch_groups)
+        local = client is None and scheduler is None
+        if local:
+            workers = workers or os.cpu_count() or 1
+            if threads is None:
+                threads = max(1, (os.cpu_count() or 1) // workers)
+        todo = len(plan.todo)
+        if log is not None:
+            where = f"a local cluster of {workers} worker process(es), {threads} thread(s) " \
+                    "each" if local else \
+                f"the Dask scheduler at {scheduler or client.scheduler.address}"
+            log(f"{len(plan.points)} points ({' x '.join(map(str, plan.spec.shape)) or '1'}): "
+                f"{len(plan.points) - todo} finished earlier, {todo} to run on {where}")
+
+        def finish():
+            dataset = plan.dataset()
+            if output is not None:
+                write_dataset(dataset, Path(output))
+            return dataset
+
+        if not todo:
+            return finish()
+        from .execute import dask_client
+        with dask_client(workers, scheduler, client) as dask:
+            try:
+                run(plan, dask, threads, progress,
+                    workers_write=local if workers_write is None else workers_write)
+            finally:   # also on Ctrl-C: the points done so far, before the cluster closes
+                dataset = finish()
+    return dataset
+
+class _CallableModule(type(tempfile)):
+    """`oceanmc.sweep` is both this package and the function: importing a submodule makes the
+    package an attribute of `oceanmc`, which would hide the function, so the package itself can
+    be called: oceanmc.sweep(...) is sweep(...)."""
+
+    def __call__(self, *args, **kwargs):
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

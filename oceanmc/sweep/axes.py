@@ -1,0 +1,283 @@
+"""The sweep file and its axes: key paths into a scene, the values along each axis, the grid of
+points (every combination of the axes; the keys of a `zip` group vary together, as one axis).
+
+A key path names one value of the scene the way the README's tables do, with list indices in
+brackets: `water.layers[0].a`, `bottom.reflectance`, `illumination.sun_zenith_deg`,
+`water.layers[0].phase.components[1].b` (negative indices count from the end, as in Python).
+Nothing here knows the scene's schema: a path reaches whatever the base scene's mapping holds,
+so keys added to the schema later are reachable without a change here; the scene's own
+validation (points.py) then judges every value.
+"""
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..config import ConfigError
+
+# a key, then any number of [index]: `layers[0]`, `components[-1]`, `bottom`
+_SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d+\])*)$")
+_INDEX = re.compile(r"\[(-?\d+)\]")
+SWEEP_KEYS = ("base", "set", "axes", "batch_groups")
+GENERATORS = ("linspace", "geomspace")
+
+
+class SweepError(ConfigError):
+    """A sweep file or a point of it that cannot run; the message names the key, the value, the
+    point's coordinates where there is one, and what is allowed."""
+
+
+def parse_key_path(path: str) -> list[str | int]:
+    """`water.layers[0].a` -> ['water', 'layers', 0, 'a']."""
+    if not isinstance(path, str) or not path:
+        raise SweepError(f"axes: {path!r} is not a key path (e.g. water.layers[0].a)")
+    steps: list[str | int] = []
+    for segment in path.split("."):
+        match = _SEGMENT.match(segment)
+        if match is None:
+            raise SweepError(f"axes: {path!r} is not a key path: {segment!r} should be a key "
+                             "optionally followed by list indices, e.g. layers[0]")
+        steps.append(match.group(1))
+        steps += [int(i) for i in _INDEX.findall(match.group(2))]
+    return steps
+
+
+def set_key_path(scene: dict, path: str, value: Any) -> None:
+    """Sets the value at a key path in a scene mapping (in place). Missing mappings on the way are
+    created (a key the base scene leaves at its default); a list index must exist."""
+    steps = parse_key_path(path)
+    node: Any = scene
+    for depth, (step, following) in enumerate(zip(steps, steps[1:] + [None])):
+        where = _render(steps[:depth]) or "the scene"
+        last = following is None
+        if isinstance(step, int):
+            if not isinstance(node, list):
+                raise SweepError(f"axes: {path}: {where} is not a list, so [{step}] does not "
+                                 "apply")
+            if not -len(node) <= step < len(node):
+                raise SweepError(f"axes: {path}: {where} has {len(node)} entr"
+                                 f"{'y' if len(node) == 1 else 'ies'} in the base scene; allowed "
+                                 f"indices {-len(node)} .. {len(node) - 1}")
+        elif not isinstance(node, dict):
+            raise SweepError(f"axes: {path}: {where} is not a mapping, so it has no key "
+                             f"{step!r}")
+        if last:
+            node[step] = value
+        elif isinstance(step, str) and node.get(step) is None:
+            node[step] = {} if isinstance(following, str) else []
+            node = node[step]
+        else:
+            node = node[step]
+
+
+def _render(steps: list[str | int]) -> str:
+    text = ""
+    for step in steps:
+        text += f"[{step}]" if isinstance(step, int) else ("." if text else "") + step
+    return text
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One dimension of the sweep: a key path and its values, or a zip group of several key
+    paths whose values vary together (then the dimension is named after the first)."""
+    keys: tuple[str, ...]
+    values: tuple[tuple[Any, ...], ...]   # values[k][i]: key k at position i
+
+    @property
+    def dim(self) -> str:
+        return self.keys[0]
+
+    def __len__(self) -> int:
+        return len(self.values[0])
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A parsed sweep: the base scene (a mapping, as written), its folder (for the table files
+    it names), settings applied to every point, the axes, and how many batch groups each point
+    is spread over."""
+    base: dict
+    base_dir: Path
+    settings: dict[str, Any]
+    axes: tuple[Axis, ...]
+    batch_groups: int
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(axis) for axis in self.axes)
+
+    def points(self):
+        """(index tuple, [(key path, value), ...]) for every point, in C order."""
+        for index in itertools.product(*(range(len(axis)) for axis in self.axes)):
+            yield index, [(key, axis.values[k][i]) for axis, i in zip(self.axes, index)
+                          for k, key in enumerate(axis.keys)]
+
+    def scene_at(self, assignments) -> dict:
+        scene = copy.deepcopy(self.base)
+        for key, value in list(self.settings.items()) + list(assignments):
+            set_key_path(scene, key, value)
+        return scene
+
+    def to_yaml(self) -> str:
+        """The sweep as a YAML text (stored in the dataset's attributes)."""
+        axes: dict[str, Any] = {}
+        zips = []
+        for axis in self.axes:
+            if len(axis.keys) == 1:
+                axes[axis.keys[0]] = list(axis.values[0])
+            else:
+                zips.append({key: list(values) for key, values in zip(axis.keys, axis.values)})
+        if zips:
+            axes["zip"] = zips
+        return yaml.safe_dump({"set": self.settings, "axes": axes,
+                               "batch_groups": self.batch_groups}, sort_keys=False)
+
+
+def load_sweep(source: str | Path | dict) -> SweepSpec:
+    """Reads a sweep (a YAML file or a mapping with `base`, `axes`, optional `set` and
+    `batch_groups`). `base` is a scene file (relative to the sweep file), a scene mapping, or a
+    SceneConfig."""
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise SweepError(f"{path}: no such file") from None
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+            raise SweepError(f"{path}: cannot read it as YAML "
+                             f"({str(exc).splitlines()[0]})") from None
+        folder = path.parent
+    else:
+        data, folder = source, Path.cwd()
+    if not isinstance(data, dict):
+        raise SweepError(f"sweep: the top level must be a mapping with keys {', '.join(SWEEP_KEYS)}"
+                         f", got {type(data).__name__}")
+    unknown = sorted(set(data) - set(SWEEP_KEYS))
+    if unknown:
+        raise SweepError(f"sweep: {unknown[0]}: unknown key; allowed: {', '.join(SWEEP_KEYS)}")
+    base, base_dir = _base_scene(data.get("base"), folder)
+    settings = data.get("set") or {}
+    if not isinstance(settings, dict):
+        raise SweepError(f"set: expected a mapping of key paths to values, got {settings!r}")
+    for key in settings:
+        parse_key_path(key)
+    axes = _axes(data.get("axes"))
+    groups = data.get("batch_groups", 1)
+    if isinstance(groups, bool) or not isinstance(groups, int) or groups < 1:
+        raise SweepError(f"batch_groups = {groups!r}: expected an integer >= 1 (the number of "
+                         "tasks each point's batches are spread over)")
+    return SweepSpec(base, base_dir, dict(settings), axes, groups)
+
+
+def _base_scene(base: Any, folder: Path) -> tuple[dict, Path]:
+    from ..config import SceneConfig
+    if base is None:
+        raise SweepError("base: required key is missing (a scene file or a scene mapping)")
+    if isinstance(base, SceneConfig):
+        return base.model_dump(), folder
+    if isinstance(base, (str, Path)):
+        path = Path(base) if Path(base).is_absolute() else folder / base
+        try:
+            scene = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise SweepError(f"base = {str(base)!r}: no such file ({path})") from None
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+            raise SweepError(f"base = {str(base)!r}: cannot read it as YAML "
+                             f"({str(exc).splitlines()[0]})") from None
+        if not isinstance(scene, dict):
+            raise SweepError(f"base = {str(base)!r}: not a scene (a mapping of keys)")
+        return scene, path.parent
+    if isinstance(base, dict):
+        return copy.deepcopy(base), folder
+    raise SweepError(f"base = {base!r}: expected a scene file or a scene mapping")
+
+
+def _axes(spec: Any) -> tuple[Axis, ...]:
+    if spec is None:
+        return ()
+    if not isinstance(spec, dict):
+        raise SweepError(f"axes: expected a mapping of key paths to lists of values, got "
+                         f"{type(spec).__name__}")
+    axes = []
+    for key, values in spec.items():
+        if key == "zip":
+            groups = values if isinstance(values, list) else [values]
+            for group in groups:
+                axes.append(_zip_axis(group))
+        else:
+            parse_key_path(key)
+            axes.append(Axis((key,), (_values(key, values),)))
+    seen: set[str] = set()
+    for axis in axes:
+        for key in axis.keys:
+            if key in seen:
+                raise SweepError(f"axes: {key} appears twice")
+            seen.add(key)
+    return tuple(axes)
+
+
+def _zip_axis(group: Any) -> Axis:
+    if not isinstance(group, dict) or len(group) < 2:
+        raise SweepError(f"axes.zip: expected a mapping of two or more key paths to lists of "
+                         f"equal length, got {group!r}")
+    keys = tuple(group)
+    for key in keys:
+        parse_key_path(key)
+    values = tuple(_values(key, group[key]) for key in keys)
+    lengths = {key: len(v) for key, v in zip(keys, values)}
+    if len(set(lengths.values())) > 1:
+        raise SweepError(f"axes.zip: the lists must have equal lengths; got "
+                         f"{', '.join(f'{k}: {n}' for k, n in lengths.items())}")
+    return Axis(keys, values)
+
+
+def _values(key: str, values: Any) -> tuple[Any, ...]:
+    """A list as written, or {linspace: [start, stop, num]} / {geomspace: [start, stop, num]}
+    (numpy's, end points included)."""
+    if isinstance(values, dict):
+        if len(values) != 1 or next(iter(values)) not in GENERATORS:
+            raise SweepError(f"axes: {key} = {values!r}: expected a list of values or one of "
+                             f"{', '.join(f'{{{g}: [start, stop, num]}}' for g in GENERATORS)}")
+        (kind, args), = values.items()
+        if not (isinstance(args, list) and len(args) == 3
+                and all(isinstance(a, (int, float)) and not isinstance(a, bool) for a in args)
+                and isinstance(args[2], int) and args[2] >= 1
+                and all(math.isfinite(a) for a in args)):
+            raise SweepError(f"axes: {key}.{kind} = {args!r}: expected [start, stop, num] with "
+                             "finite numbers and an integer num >= 1")
+        if kind == "geomspace" and args[0] * args[1] <= 0:
+            raise SweepError(f"axes: {key}.geomspace = {args!r}: start and stop must be "
+                             "non-zero and of the same sign")
+        grid = getattr(np, kind)(float(args[0]), float(args[1]), int(args[2]))
+        return tuple(float(v) for v in grid)
+    if not isinstance(values, list) or not values:
+        raise SweepError(f"axes: {key} = {values!r}: expected a non-empty list of values")
+    return tuple(values)
+
+
+def coordinate(values: tuple[Any, ...]) -> np.ndarray:
+    """An axis's values as a coordinate array: numbers as float64 (int64 when all are integers),
+    text as strings, anything else (a mapping, a list) as its YAML text."""
+    if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+        return np.array(values, dtype=np.int64)
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        return np.array(values, dtype=np.float64)
+    if all(isinstance(v, str) for v in values):
+        return np.array(values, dtype=object)
+    return np.array([yaml.safe_dump(v, default_flow_style=True).strip() for v in values],
+                    dtype=object)
+
+
+def label(assignments) -> str:
+    """A point's coordinates for messages: `water.layers[0].a = 0.1, bottom.reflectance = 0.2`."""
+    return ", ".join(f"{key} = {yaml.safe_dump(value, default_flow_style=True).strip()}"
+                     .replace("\n...", "") for key, value in assignments)

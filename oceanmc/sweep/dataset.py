@@ -1,0 +1,194 @@
+"""The sweep's results: each finished point kept as its own results file in a folder beside the
+dataset (what a rerun skips and a Ctrl-C keeps), and the dataset assembled from them, written
+atomically as NetCDF4 (HDF5, via h5netcdf).
+
+Dataset layout: one dimension per axis (named by its key path; the other keys of a zip group
+are coordinates along it), then each quantity's own dimensions (depth, theta, phi, direction);
+every quantity X of the results file (`air/Rrs_nadir` becomes `air_Rrs_nadir`, `budget/total`
+`budget_total`) with `X_stderr` beside it; per point `status` (done, failed, pending), `error`,
+`photons` and `wall_time_s`; the base scene and the sweep in the attributes."""
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .. import __version__
+from ..run.hdf5 import COORD_UNITS, load_result
+from ..run.results import Result, merge_results
+from .axes import SweepSpec, coordinate
+from .points import Point
+
+DONE, FAILED, PENDING = "done", "failed", "pending"
+
+
+@dataclass
+class Summary:
+    """What the dataset keeps of a point's Result: estimates, standard errors, coordinates."""
+    quantities: dict[str, tuple[tuple[str, ...], np.ndarray, np.ndarray, str, str]]
+    coords: dict[str, np.ndarray]
+    photons: int
+    wall_time_s: float
+
+    @classmethod
+    def of(cls, result: Result) -> "Summary":
+        return cls({name: (q.dims, q.mean, q.stderr, q.units, q.description)
+                    for name, q in result.quantities.items()},
+                   dict(result.coords), int(result.attrs["photons"]),
+                   float(result.attrs["wall_time_s"]))
+
+
+class PointStore:
+    """A folder of results files, one per finished point (`<key>.h5`, the file `oceanmc run`
+    would write for that scene) and one per finished batch group of a point spread over several
+    tasks (`<key>.batches-<first>-<end>.h5`, merged into the point's file when all are in)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+
+    def path(self, point: Point, batches: tuple[int, int] | None = None) -> Path:
+        if batches is None:
+            return self.folder / f"{point.key}.h5"
+        return self.folder / f"{point.key}.batches-{batches[0]}-{batches[1]}.h5"
+
+    def _load(self, path: Path, scene_yaml: str) -> Result | None:
+        """The stored result if it is complete and of exactly this scene."""
+        if not path.is_file():
+            return None
+        try:
+            result = load_result(path)
+        except (OSError, KeyError, ValueError):
+            return None  # unreadable: run it again
+        if result.config_yaml != scene_yaml or result.attrs.get("partial", False):
+            return None
+        return result
+
+    def finished(self, point: Point) -> Summary | None:
+        result = self._load(self.path(point), point.yaml)
+        return None if result is None else Summary.of(result)
+
+    def part_done(self, point: Point, batches: tuple[int, int]) -> bool:
+        return self._load(self.path(point, batches), point.part_yaml(*batches)) is not None
+
+    def save(self, point: Point, result: Result) -> Summary:
+        result.save(self.path(point))
+        return Summary.of(result)
+
+    def save_part(self, point: Point, batches: tuple[int, int], result: Result) -> None:
+        result.save(self.path(point, batches))
+
+    def merge_parts(self, point: Point, ranges: list[tuple[int, int]]) -> Summary:
+        """The point's Result from its batch groups: their batches concatenated in order, which
+        is the Result of one run of all of them (same batches, same means, same errors)."""
+        parts = []
+        for batches in ranges:
+            part = self._load(self.path(point, batches), point.part_yaml(*batches))
+            part.attrs["config_yaml"] = point.yaml   # the same batches of the point's scene
+            parts.append(part)
+        result = merge_results(parts, resume=True) if len(parts) > 1 else parts[0]
+        summary = self.save(point, result)
+        for batches in ranges:
+            self.path(point, batches).unlink(missing_ok=True)
+        return summary
+
+
+def variable_name(quantity: str) -> str:
+    """`air/Rrs_nadir` -> `air_Rrs_nadir`: one flat dataset (a '/' would mean a group)."""
+    return quantity.replace("/", "_")
+
+
+def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary],
+             errors: dict[str, str]):
+    """The sweep's xarray Dataset from the points finished so far (NaN where a point failed or
+    has not run yet; `status` says which)."""
+    import xarray as xr
+
+    shape = spec.shape
+    dims = tuple(axis.dim for axis in spec.axes)
+    coords: dict[str, tuple] = {}
+    for axis in spec.axes:
+        for key, values in zip(axis.keys, axis.values):
+            coords[key] = (axis.dim, coordinate(values),
+                           {"description": f"the scene's {key} along this axis"})
+    status = np.full(shape, PENDING, dtype=object)
+    error = np.full(shape, "", dtype=object)
+    photons = np.zeros(shape, dtype=np.int64)
+    wall = np.full(shape, np.nan)
+    data: dict[str, tuple] = {}
+    reference = next((summaries[p.key] for p in points if p.key in summaries), None)
+    if reference is not None:
+        for name, values in reference.coords.items():
+            if name in ("direction_theta", "direction_phi"):
+                coords[name] = ("direction", values, _coord_attrs(name))
+            elif name not in coords:
+                coords[name] = (name, values, _coord_attrs(name))
+    arrays: dict[str, tuple] = {}
+    for point in points:
+        summary = summaries.get(point.key)
+        if summary is None:
+            if point.key in errors:
+                status[point.index], error[point.index] = FAILED, errors[point.key]
+            continue
+        status[point.index] = DONE
+        photons[point.index] = summary.photons
+        wall[point.index] = summary.wall_time_s
+        for name, (qdims, mean, stderr, units, description) in summary.quantities.items():
+            if name not in arrays:
+                arrays[name] = (qdims, np.full(shape + mean.shape, np.nan),
+                                np.full(shape + mean.shape, np.nan), units, description)
+            arrays[name][1][point.index] = mean
+            arrays[name][2][point.index] = stderr
+    for name, (qdims, mean, stderr, units, description) in arrays.items():
+        var = variable_name(name)
+        data[var] = (dims + qdims, mean, {"units": units, "description": description})
+        data[var + "_stderr"] = (dims + qdims, stderr,
+                                 {"units": units, "description": f"standard error of {var}"})
+    data["status"] = (dims, status.astype(str), {"description": "done, failed or pending "
+                                                 "(not run yet: an interrupted sweep)"})
+    data["error"] = (dims, error.astype(str), {"description": "why a failed point failed"})
+    data["photons"] = (dims, photons, {"description": "photons traced at the point"})
+    data["wall_time_s"] = (dims, wall, {"units": "s", "description": "run time of the point"})
+    counts = {s: int((status == s).sum()) for s in (DONE, FAILED, PENDING)}
+    attrs = {
+        "title": "oceanmc sweep",
+        "oceanmc_version": __version__,
+        "base_scene_yaml": yaml.safe_dump(spec.base, sort_keys=False),
+        "sweep_yaml": spec.to_yaml(),
+        "axes": ",".join(dims),
+        "points": int(np.prod(shape, dtype=np.int64)),
+        "points_done": counts[DONE],
+        "points_failed": counts[FAILED],
+        "points_pending": counts[PENDING],
+        "partial": int(counts[PENDING] > 0),
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _coord_attrs(name: str) -> dict:
+    units, description = COORD_UNITS[name]
+    return {"units": units, "description": description}
+
+
+def write_dataset(dataset, path: Path) -> Path:
+    """NetCDF4 via h5netcdf, atomically (a temporary file renamed into place), so a crash or a
+    second Ctrl-C never leaves half a dataset."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    os.close(fd)
+    try:
+        dataset.to_netcdf(tmp, engine="h5netcdf")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path

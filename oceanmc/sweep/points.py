@@ -1,0 +1,102 @@
+"""The sweep's points as scenes: each one built from the base scene and its coordinates,
+validated as `oceanmc run` validates a scene (the schema, then the packing of the scene, which
+reads and checks auxiliary tables) before any photon runs, and named by a hash of its resolved
+scene, so that a rerun finds the points it has already done whatever the order of the axes."""
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass
+
+from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
+from .axes import SweepError, SweepSpec, label
+
+
+@dataclass(frozen=True)
+class Point:
+    index: tuple[int, ...]   # position on the axes
+    label: str               # its coordinates, for messages
+    config: SceneConfig
+    yaml: str                # the resolved scene: `oceanmc run` of this text is this point
+
+    @property
+    def key(self) -> str:
+        return hashlib.sha256(self.yaml.encode()).hexdigest()[:20]
+
+    def batch_ranges(self, groups: int) -> list[tuple[int, int]]:
+        """The batches split into up to `groups` contiguous ranges [first, end) of near-equal
+        size (never an empty one)."""
+        n = self.config.batches
+        groups = min(groups, n)
+        edges = [round(i * n / groups) for i in range(groups + 1)]
+        return list(zip(edges[:-1], edges[1:]))
+
+    def part_yaml(self, first: int, end: int) -> str:
+        """The scene that runs batches first .. end-1 of this point: the same scene with its
+        batch count cut at `end` and as many photons per batch. Batch b's random stream depends
+        only on (seed, b), so these batches are the point's own (simulate(first_batch=...))."""
+        if (first, end) == (0, self.config.batches):
+            return self.yaml
+        per_batch = math.ceil(self.config.photons / self.config.batches)
+        part = self.config.model_copy(update={"batches": end, "photons": per_batch * end})
+        return config_to_yaml(part)
+
+
+def build_points(spec: SweepSpec) -> list[Point]:
+    """Every point's scene, validated; raises SweepError naming the first bad point's
+    coordinates (and how many more are bad)."""
+    points: list[Point] = []
+    bad: list[str] = []
+    for index, assignments in spec.points():
+        where = label(assignments)
+        try:
+            config = load_config(spec.scene_at(assignments), base_dir=spec.base_dir)
+        except SweepError as exc:
+            raise SweepError(str(exc)) from None   # a key path the base scene does not have
+        except ConfigError as exc:
+            bad.append(f"point ({where}): {_without_origin(exc)}")
+            continue
+        points.append(Point(index, where, config, config_to_yaml(config)))
+    if bad:
+        _raise_first(bad)
+    _check_same_tallies(points)
+    return points
+
+
+def check_scenes(points: list[Point]) -> None:
+    """Packs every point's scene (which reads and checks its table files, BRDF checks and
+    tables: ConfigError) without tracing a photon. Needs the compiled kernel (run.compiling)."""
+    from .. import scene
+    bad = []
+    for point in points:
+        try:
+            scene.build(point.config)
+        except ConfigError as exc:
+            bad.append(f"point ({point.label}): {_without_origin(exc)}")
+    if bad:
+        _raise_first(bad)
+
+
+def _without_origin(exc: ConfigError) -> str:
+    text = str(exc)
+    return text[len("config: "):] if text.startswith("config: ") else text
+
+
+def _raise_first(bad: list[str]) -> None:
+    more = f" (and {len(bad) - 1} more point{'s' if len(bad) > 2 else ''})" if len(bad) > 1 \
+        else ""
+    raise SweepError(bad[0] + more)
+
+
+def _check_same_tallies(points: list[Point]) -> None:
+    """One dataset needs the same depths, angular grid and directions at every point."""
+    if not points:
+        return
+    first = points[0].config.tallies
+    for point in points[1:]:
+        if point.config.tallies != first:
+            changed = [name for name in type(first).model_fields
+                       if getattr(point.config.tallies, name) != getattr(first, name)]
+            raise SweepError(f"point ({point.label}): tallies.{changed[0]} differs from the first "
+                             f"point's: every point of a sweep needs the same tallies (depths, "
+                             "angular grid, directions), which become the dataset's dimensions")

@@ -1,0 +1,261 @@
+"""`oceanmc sweep`: key paths and axes, validation before any photon, and real Dask clusters on
+127.0.0.1 (a LocalCluster of two worker processes; a scheduler and two workers started as
+separate processes, one of them killed mid-sweep; a rerun after Ctrl-C). Every point is checked
+bit for bit against simulate() of its scene, which is what `oceanmc run` of it computes."""
+import copy
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+import oceanmc
+from conftest import REPO
+from oceanmc.sweep import SweepError, load_sweep, set_key_path
+from oceanmc.sweep.dataset import variable_name
+from oceanmc.sweep.points import build_points
+
+ENV = dict(os.environ, PYTHONPATH=str(REPO))
+PYTHON_BIN = Path(sys.executable).parent
+
+TINY = {
+    "name": "tiny sweep scene",
+    "photons": 1200,
+    "batches": 4,
+    "seed": 7,
+    "illumination": {"sun_zenith_deg": 30, "diffuse_fraction": 0.2},
+    "water": {"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4,
+                          "phase": {"model": "henyey_greenstein", "g": 0.8}}]},
+    "bottom": {"model": "lambertian", "reflectance": 0.3},
+    "tallies": {"depths_m": [0, 1]},
+}
+
+
+def sweep_file(tmp_path, axes, base=TINY, **extra):
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump({"base": base, "axes": axes, **extra}, sort_keys=False))
+    return path
+
+
+def oceanmc_cli(*args, cwd, **kwargs):
+    return subprocess.Popen([sys.executable, "-m", "oceanmc", *map(str, args)], cwd=cwd,
+                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            **kwargs)
+
+
+def assert_points_match_single_runs(ds, spec_source, only_done=False):
+    """Each done point's estimates and standard errors equal those of one simulate() of its
+    scene, exactly."""
+    checked = 0
+    for point in build_points(load_sweep(spec_source)):
+        if ds["status"].values[point.index] != "done":
+            assert only_done, point.label
+            continue
+        single = oceanmc.simulate(point.config, threads=1)
+        for name, q in single.quantities.items():
+            var = variable_name(name)
+            assert np.array_equal(ds[var].values[point.index], q.mean, equal_nan=True), \
+                (point.label, name)
+            assert np.array_equal(ds[var + "_stderr"].values[point.index], q.stderr,
+                                  equal_nan=True), (point.label, name)
+        checked += 1
+    return checked
+
+
+# --- key paths and axes (no cluster) -------------------------------------------------------------
+
+def test_key_paths_reach_nested_lists_and_create_missing_mappings():
+    scene = copy.deepcopy(TINY)
+    scene["water"]["layers"][0]["phase"] = {"model": "mixture", "components": [
+        {"b": 0.1, "phase": {"model": "pure_water"}}, {"b": 0.3, "phase": {"model": "petzold"}}]}
+    set_key_path(scene, "water.layers[0].phase.components[1].b", 0.5)
+    set_key_path(scene, "water.layers[-1].a", 0.2)
+    set_key_path(scene, "surface.n_water", 1.33)          # `surface` is not in the base scene
+    assert scene["water"]["layers"][0]["phase"]["components"][1]["b"] == 0.5
+    assert scene["water"]["layers"][0]["a"] == 0.2
+    assert scene["surface"] == {"n_water": 1.33}
+    with pytest.raises(SweepError, match=r"water\.layers has 1 entry .*allowed indices -1 \.\. 0"):
+        set_key_path(scene, "water.layers[1].a", 0.1)
+    with pytest.raises(SweepError, match="bottom is not a list"):
+        set_key_path(scene, "bottom[0].reflectance", 0.1)
+    with pytest.raises(SweepError, match="not a key path"):
+        set_key_path(scene, "water..a", 0.1)
+
+
+def test_axes_product_zip_and_generators(tmp_path):
+    spec = load_sweep(sweep_file(tmp_path, {
+        "water.layers[0].a": {"geomspace": [0.01, 1.0, 3]},
+        "zip": {"illumination.sun_zenith_deg": [0, 60],
+                "illumination.diffuse_fraction": [0.1, 0.3]},
+    }))
+    assert spec.shape == (3, 2)
+    points = build_points(spec)
+    assert len(points) == 6 and len({p.key for p in points}) == 6
+    last = points[-1].config
+    assert last.water.layers[0].a == pytest.approx(1.0)
+    assert (last.illumination.sun_zenith_deg, last.illumination.diffuse_fraction) == (60, 0.3)
+    with pytest.raises(SweepError, match="equal lengths"):
+        load_sweep(sweep_file(tmp_path, {"zip": {"bottom.reflectance": [0.1, 0.2],
+                                                 "water.layers[0].a": [0.1]}}))
+
+
+def test_every_point_is_validated_first_with_its_coordinates_one_line_exit_2(tmp_path):
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2],
+                                 "bottom.reflectance": [0.5, 1.5]})
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", path, "-o", "lut.nc"],
+                          cwd=tmp_path, env=ENV, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    lines = [line for line in done.stderr.splitlines() if "compil" not in line]
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("oceanmc: config error: point (water.layers[0].a = 0.1, "
+                               "bottom.reflectance = 1.5): bottom.reflectance = 1.5")
+    assert "(and 1 more point)" in lines[0]
+    assert not (tmp_path / "lut.nc").exists() and not (tmp_path / "lut.points").exists()
+    with pytest.raises(SweepError, match=r"tallies\.depths_m differs"):
+        build_points(load_sweep(sweep_file(tmp_path, {"tallies.depths_m": [[0], [0, 1]]})))
+
+
+# --- a LocalCluster of two worker processes ---------------------------------------------------
+
+def test_local_cluster_two_processes_points_bit_identical_batch_groups_and_rerun(tmp_path):
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.2],
+                                 "zip": {"bottom.reflectance": [0.1, 0.4],
+                                         "bottom.model": ["lambertian", "lambertian"]}},
+                      batch_groups=2)
+    out = tmp_path / "lut.nc"
+    ds = oceanmc.sweep(path, out, workers=2, threads=1)
+    assert ds.attrs["points_done"] == 4 and ds.attrs["partial"] == 0
+    assert ds["air_Rrs_nadir"].dims == ("water.layers[0].a", "bottom.reflectance")
+    assert ds["radiance"].dims[2:] == ("depth", "theta", "phi")
+    assert list(ds["bottom.model"].values) == ["lambertian", "lambertian"]
+    stored = xr.open_dataset(out, engine="h5netcdf")
+    assert yaml.safe_load(stored.attrs["base_scene_yaml"]) == TINY
+    assert "water.layers[0].a" in yaml.safe_load(stored.attrs["sweep_yaml"])["axes"]
+    xr.testing.assert_identical(stored.load(), ds)
+    # batches spread over two tasks per point, merged: the same numbers as one run
+    assert assert_points_match_single_runs(ds, path) == 4
+    # more photons per point beside the reflectance axis: the finished points are skipped
+    spec = yaml.safe_load(path.read_text())
+    spec["axes"]["water.layers[0].a"].append(0.4)
+    path.write_text(yaml.safe_dump(spec, sort_keys=False))
+    said = []
+    again = oceanmc.sweep(path, out, workers=2, threads=1, log=said.append)
+    assert "4 finished earlier, 2 to run" in said[0]
+    assert again.attrs["points_done"] == 6
+    xr.testing.assert_equal(again.isel({"water.layers[0].a": slice(0, 2)})
+                                .drop_vars(["wall_time_s"]), ds.drop_vars(["wall_time_s"]))
+
+
+def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch):
+    from distributed import Client, LocalCluster
+
+    import oceanmc.run.simulation as simulation
+    real = simulation.simulate
+
+    def simulate(config, **kwargs):
+        if config.water.layers[0].a == 0.2:
+            raise FloatingPointError("the kernel gave up on this point")
+        return real(config, **kwargs)
+
+    monkeypatch.setattr(simulation, "simulate", simulate)  # the workers are threads here
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2, 0.3]})
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        ds = oceanmc.sweep(path, tmp_path / "lut.nc", client=client, threads=1)
+    assert list(ds["status"].values) == ["done", "failed", "done"]
+    assert ds["error"].values[1] == "FloatingPointError: the kernel gave up on this point"
+    assert np.isnan(ds["air_Rrs_nadir"].values[1])
+    assert np.all(np.isfinite(ds["air_Rrs_nadir"].values[[0, 2]]))
+    assert ds.attrs["points_failed"] == 1
+
+
+# --- a scheduler and two workers as separate processes; one killed mid-sweep ----------------
+
+@pytest.fixture
+def dask_processes(tmp_path):
+    scheduler_file = tmp_path / "scheduler.json"
+    dask = str(PYTHON_BIN / "dask")
+    started = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
+                                 "--no-dashboard", "--scheduler-file", scheduler_file],
+                                env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    deadline = time.monotonic() + 60
+    while not scheduler_file.is_file():
+        assert time.monotonic() < deadline, "the Dask scheduler did not start"
+        time.sleep(0.1)
+    address = yaml.safe_load(scheduler_file.read_text())["address"]
+    for _ in range(2):
+        started.append(subprocess.Popen(
+            [dask, "worker", address, "--host", "127.0.0.1", "--nthreads", "1", "--no-nanny",
+             "--no-dashboard"], env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+    from distributed import Client
+    with Client(address, timeout="60s") as client:
+        client.wait_for_workers(2, timeout=60)
+    yield address, started[1:]
+    for process in reversed(started):
+        process.kill()
+        process.wait()
+
+
+def test_separate_scheduler_and_workers_survive_a_killed_worker(tmp_path, dask_processes):
+    address, workers = dask_processes
+    scene = copy.deepcopy(TINY)
+    scene["photons"] = 8000      # long enough that the killed worker has points in hand
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1, 0.2, 0.3],
+                                 "bottom.reflectance": [0.1, 0.5]}, base=scene)
+    points = tmp_path / "lut.points"
+    run = oceanmc_cli("sweep", path, "-o", "lut.nc", "--scheduler", address, "--threads", "1",
+                      "-q", cwd=tmp_path)
+    deadline = time.monotonic() + 120
+    while not (points.is_dir() and any(points.glob("*.h5"))):
+        assert run.poll() is None, run.communicate()
+        assert time.monotonic() < deadline, "no point finished"
+        time.sleep(0.05)
+    workers[0].kill()       # SIGKILL: its points in hand are lost and must be run elsewhere
+    out, err = run.communicate(timeout=240)
+    assert run.returncode == 0, err
+    assert "8 of 8 points done, 0 failed" in out
+    ds = xr.open_dataset(tmp_path / "lut.nc", engine="h5netcdf").load()
+    assert (ds["status"].values == "done").all()
+    assert assert_points_match_single_runs(ds, path) == 8
+
+
+# --- Ctrl-C, then a rerun -------------------------------------------------------------------
+
+def test_ctrl_c_leaves_a_valid_partial_dataset_and_a_rerun_finishes_it(tmp_path):
+    scene = copy.deepcopy(TINY)
+    scene["photons"] = 20000
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1, 0.2, 0.3, 0.4, 0.5]},
+                      base=scene)
+    points = tmp_path / "lut.points"
+    run = oceanmc_cli("sweep", path, "-o", "lut.nc", "--workers", "1", "-q", cwd=tmp_path)
+    deadline = time.monotonic() + 120
+    while not (points.is_dir() and any(points.glob("*.h5"))):
+        assert run.poll() is None, run.communicate()
+        assert time.monotonic() < deadline, "no point finished"
+        time.sleep(0.05)
+    run.send_signal(signal.SIGINT)
+    out, err = run.communicate(timeout=120)
+    assert run.returncode == 130, err
+    assert "sweep interrupted: wrote lut.nc" in err
+    partial = xr.open_dataset(tmp_path / "lut.nc", engine="h5netcdf").load()
+    done = int((partial["status"].values == "done").sum())
+    assert partial.attrs["partial"] == 1 and 1 <= done < 6
+    assert partial.attrs["points_pending"] == 6 - done
+    assert np.isnan(partial["Ed"].values[partial["status"].values == "pending"]).all()
+    assert assert_points_match_single_runs(partial, path, only_done=True) == done
+    rerun = oceanmc_cli("sweep", path, "-o", "lut.nc", "--workers", "1", "-q", cwd=tmp_path)
+    out, err = rerun.communicate(timeout=240)
+    assert rerun.returncode == 0, err
+    # the point in hand when Ctrl-C came may have been written since, by its worker
+    earlier = int(re.search(r"(\d+) finished earlier, (\d+) to run", err).group(1))
+    assert done <= earlier < 6 and f"{earlier} finished earlier, {6 - earlier} to run" in err
+    final = xr.open_dataset(tmp_path / "lut.nc", engine="h5netcdf").load()
+    assert final.attrs["partial"] == 0 and (final["status"].values == "done").all()
+    assert assert_points_match_single_runs(final, path) == 6
