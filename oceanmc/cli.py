@@ -297,6 +297,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.sweep:
         from .bench import sweep
         return sweep.main(Path(args.output), quick=args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
