@@ -50,8 +50,8 @@ def compare_with_singles(config: dict, compared=COMPARED) -> None:
                for k in range(len(config["wavelengths_nm"]))]
     n_compared = sum(spectral[name].size for name in compared)
     for name in compared:
-        reference = np.stack([s[name][0] for s in singles])
-        ref_se = np.stack([s.stderr(name)[0] for s in singles])
+        reference = np.stack([s[name] for s in singles])
+        ref_se = np.stack([s.stderr(name) for s in singles])
         assert_z(spectral[name], reference, np.hypot(spectral.stderr(name), ref_se),
                  n_compared=n_compared, dof=dof_of(spectral), rel_max=0.1, abs_max=2e-3,
                  what=name)
@@ -86,8 +86,8 @@ def test_spectral_illumination_sun_and_sky_shares(tmp_path):
     np.testing.assert_allclose(spectral["air/Ed"], ed0, rtol=1e-9)
     singles = [oceanmc.simulate(single(config, k, 200 + k), threads=THREADS) for k in range(3)]
     for name in ("Ed", "Eu"):
-        reference = np.stack([s[name][0] for s in singles])
-        ref_se = np.stack([s.stderr(name)[0] for s in singles])
+        reference = np.stack([s[name] for s in singles])
+        ref_se = np.stack([s.stderr(name) for s in singles])
         assert_z(spectral[name], reference, np.hypot(spectral.stderr(name), ref_se),
                  n_compared=18, dof=dof_of(spectral), rel_max=0.1, what=name)
 
@@ -95,7 +95,7 @@ def test_spectral_illumination_sun_and_sky_shares(tmp_path):
 def test_wavelength_dimension_and_monochromatic_layout(tmp_path):
     """A spectral file has a leading wavelength dimension (nm) that xarray names; a scene
     without wavelengths_nm keeps today's layout; one wavelength runs the monochromatic walk
-    (the same numbers as the scene without wavelengths_nm)."""
+    and keeps the monochromatic layout (the same numbers as the scene without wavelengths_nm)."""
     xr = pytest.importorskip("xarray")
     config = copy.deepcopy(SCENE)
     config["photons"] = 4000
@@ -120,8 +120,8 @@ def test_wavelength_dimension_and_monochromatic_layout(tmp_path):
     bare = oceanmc.simulate(plain, threads=THREADS)
     assert "wavelength" not in bare.coords
     assert bare.quantities["Ed"].dims == ("depth",)
-    assert one.quantities["Ed"].dims == ("wavelength", "depth")
-    np.testing.assert_array_equal(one["radiance"][0], bare["radiance"])
+    assert one.quantities["Ed"].dims == ("depth",)   # one wavelength: monochromatic layout
+    np.testing.assert_array_equal(one["radiance"], bare["radiance"])
     bare.save(tmp_path / "m.h5")
     assert "wavelength" not in xr.open_dataset(tmp_path / "m.h5", engine="h5netcdf").dims
 

@@ -76,7 +76,7 @@ def measure(quick: bool, say, threads: int = 2) -> dict:
                    "time_one_history_s": t_spectral, "time_31_runs_s": t_singles}
             for name, _ in QUANTITIES:
                 rel_one = [_relative(spectral, name, k) for k in range(len(wavelengths))]
-                rel_single = [_relative(r, name, 0) for r, _ in singles]
+                rel_single = [_relative(r, name) for r, _ in singles]
                 # a band no photon reached has rel_err inf, FOM 0
                 fom_one = [1.0 / (e * e * t_spectral) for e in rel_one]
                 fom_single = [1.0 / (e * e * t_singles) for e in rel_single]

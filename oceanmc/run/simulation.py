@@ -187,7 +187,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                 part, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
                 config.tallies.radiance, attrs, config.tallies.local_directions_deg,
                 sc.local_rows, config.nadir_local))
-        result = per_wavelength[0] if config.wavelengths_nm is None else \
+        # one wavelength: the monochromatic layout (no wavelength dimension)
+        result = per_wavelength[0] if n_wl == 1 else \
             stack_wavelengths(per_wavelength, config.wavelengths)
         result.resume_state = state
         result.iops = iops_table(sc.layers, config.wavelengths)

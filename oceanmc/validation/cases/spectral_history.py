@@ -65,8 +65,8 @@ def case_spectral_history(ctx: Ctx) -> None:
         for quantity, label, per_depth, caps in QUANTITIES:
             value = spectral[quantity].ravel()
             stderr = spectral.stderr(quantity).ravel()
-            reference = np.array([s[quantity][0] for s in singles]).ravel()
-            ref_error = np.array([s.stderr(quantity)[0] for s in singles]).ravel()
+            reference = np.array([s[quantity] for s in singles]).ravel()
+            ref_error = np.array([s.stderr(quantity) for s in singles]).ravel()
             labels = [f"{wl:g} nm" + (f" z {d:g} m" if per_depth else "")
                       for wl in WAVELENGTHS for d in (depths if per_depth else [None])]
             ctx.compare(f"{name}: {label}, one history vs one run per wavelength", value, stderr,
@@ -81,8 +81,8 @@ def case_spectral_history(ctx: Ctx) -> None:
     for ax, (name, spectral, singles) in zip(axes, figure_data):
         ax.errorbar(WAVELENGTHS, spectral["air/Rrs_nadir"], yerr=spectral.stderr("air/Rrs_nadir"),
                     fmt="o-", ms=4, label="one history")
-        ax.errorbar(np.array(WAVELENGTHS) + 3.0, [s["air/Rrs_nadir"][0] for s in singles],
-                    yerr=[s.stderr("air/Rrs_nadir")[0] for s in singles], fmt="s", ms=4,
+        ax.errorbar(np.array(WAVELENGTHS) + 3.0, [s["air/Rrs_nadir"] for s in singles],
+                    yerr=[s.stderr("air/Rrs_nadir") for s in singles], fmt="s", ms=4,
                     label="one run per wavelength")
         ax.set_title(name, fontsize=8)
         ax.set_xlabel("wavelength (nm)")
