@@ -302,9 +302,14 @@ def cmd_validate(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
 
+    if args.spectral:
+        from .bench import spectral
+        return spectral.main(Path(args.output), args.quick)
+
     if args.sweep:
         from .bench import sweep
         return sweep.main(Path(args.output), quick=args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -390,6 +395,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("-o", "--output", default="benchmarks", metavar="DIR",
                        help="report folder (default: benchmarks)")
     bench.add_argument("--quick", action="store_true", help="small counts: a smoke test")
+    bench.add_argument("--spectral", action="store_true",
+                       help="only the spectral section (one history against 31 runs): "
+                            "DIR/spectral.md")
     bench.add_argument("--sweep", action="store_true",
                        help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
                             "and 2 Dask workers against a plain loop")

@@ -28,6 +28,7 @@ from pathlib import Path
 from .measure import error_vs_time, feature_costs, long_run_reference, speed_ceiling, startup
 from .report import (fom_ratios, fom_summary, roulette_ratios, sampling_ratios, upward_ratios,
                      write_report)
+from . import spectral
 from .scenes import SKY_SPOT, scenes, sky_spot_map, sky_spot_scenes, startup_scenes
 
 
@@ -74,6 +75,8 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
             data["error_vs_time"].append(error_vs_time(
                 scene, spot_counts, spot_reference_photons, 2, say,
                 reference=(values, stderrs, f"{source}, importance sampling")))
+    say("spectral: one history against 31 runs ...")
+    data["spectral"] = spectral.measure(quick, say)
     say("start-up ...")
     with tempfile.TemporaryDirectory() as tmp:
         # last: with --quick the cached rows use this process's cache, filled by the runs above

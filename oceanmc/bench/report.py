@@ -159,6 +159,9 @@ def write_report(out_dir: Path, data: dict) -> None:
             lines.append(f"| {row['quantity']} | {row['fom_importance']:.3g} | "
                          f"{row['fom_cosine']:.3g} | {row['fom_cosine_split']:.3g} | "
                          f"{row['ratio']:.3g} | {row['ratio_split']:.3g} |")
+    if "spectral" in data:
+        from .spectral import report_lines
+        lines += [""] + report_lines(data["spectral"])
     (out_dir / "bench.md").write_text("\n".join(lines) + "\n")
 
 

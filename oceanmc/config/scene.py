@@ -108,10 +108,13 @@ class SceneConfig(_Strict):
 
     @property
     def nadir_local(self) -> bool:
-        """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator."""
+        """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator (auto: unless
+        the bottom is a mirror, the sea rough or the scene has several wavelengths, whose one-history walk
+        has no local estimates yet)."""
         mode = self.tallies.nadir_estimator
         return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom)
-                                   and self.surface.model != "cox_munk")
+                                   and self.surface.model != "cox_munk"
+                                   and len(self.wavelengths) == 1)
 
     @property
     def wavelengths(self):

@@ -30,21 +30,24 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 
 # Water column: planes (surface first, then layer boundaries and tally depths, bottom last; z =
 # inf below an infinitely deep last layer), the segments between them, the layers, the phase
-# function components of each layer and their tables, and the upward bias per layer.
-#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo, up_fraction,
-#               up_density, up_keep (n_layers); comp_cumweight (n_comps), comp_params (2 each);
+# function components of each layer and their tables, and the upward bias per layer. The
+# per-wavelength tables hold one row per wavelength (n_wl rows; a packet reads the row of its
+# `wavelength`, the hero wavelength of a spectral walk, kernel/spectral.py).
+#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo (n_wl x
+#               n_layers); up_fraction, up_density, up_keep (n_layers); comp_cumweight (n_wl x
+#               n_comps; cumulative within each layer), comp_params (2 each);
 #               tab_psi, tab_q, tab_cdf (all tables, each component at its tab_start)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len
 MEDIUM = _record(
-    "n_planes", "n_layers", "up_cos",
+    "n_planes", "n_layers", "n_wl", "n_comps", "up_cos",
     "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
     "tab_psi", "tab_q", "tab_cdf",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
     "comp_tab_start", "comp_tab_len",
-    ints=("n_planes", "n_layers", "plane_z", "plane_tau", "layer_c", "layer_inv_c",
-          "layer_albedo", "up_fraction", "up_density", "up_keep", "comp_cumweight",
+    ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
+          "layer_inv_c", "layer_albedo", "up_fraction", "up_density", "up_keep", "comp_cumweight",
           "comp_params", "tab_psi", "tab_q", "tab_cdf", "plane_tally", "segment_layer",
           "comp_start", "comp_count", "comp_model", "comp_tab_start", "comp_tab_len"))
 
@@ -73,15 +76,21 @@ SKY = _record(
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
 #               phi_edge_sin (n_phi), level_z, level_tau (n_depths)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
-#   tally row:  flux (n_levels x 4), radiance (n_levels x n_theta_cols x n_phi_cols),
-#               local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget (n_budget)
+#               spectral scenes: source_q (2 x n_wl: sun, sky), source_scale (2), bottom_q (n_wl)
+#   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: m, q
+#               (n_wl each), phase component values (max_comps)); then one block of wl_stride
+#               per wavelength: flux (n_levels x 4), radiance (n_levels x n_theta_cols x
+#               n_phi_cols), local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget
+#               (n_budget); the offsets below are those of the first block
 GRID = _record(
+    "n_wl", "wl_stride", "spectral", "source_q", "source_scale", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
     "n_lookup", "theta_cols", "phi_cols",
     "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
     "theta_lookup", "theta_is_cap",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
+    ints=("n_wl", "wl_stride", "spectral", "source_q", "source_scale", "bottom_q",
+          "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
           "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
           "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",
           "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size"))

@@ -8,7 +8,10 @@ manual, F2 surface flux tally).
 Tallies as OpenMC thinks of them: filters (level, theta band, phi band) times scores (Ed, Eu,
 Eod, Eou, radiance), in one flat row per batch (kernel/records.py, GRID). Levels: the in-water
 tally depths first, then grid.air_level (0+, all light) and grid.air_level + 1 (0+, water-leaving
-light only)."""
+light only).
+
+Spectral scenes (kernel/spectral.py) hold one block of scores per wavelength, wl_stride apart;
+score() adds a packet's weight to every block, times the wavelength's share q of it."""
 import math
 
 from .compile import kernel
@@ -100,18 +103,41 @@ def inverse_mu(uz, mu_cut, beam):
 
 
 @kernel
+def score(grid, tally, index, w):
+    """Adds weight w at `index` of the first wavelength's block, and in a spectral scene w times
+    each wavelength's share q (kernel/spectral.py) in that wavelength's block."""
+    if grid.n_wl == 1:
+        tally[index] += w
+        return
+    q = grid.spectral + grid.n_wl
+    for j in range(grid.n_wl):
+        tally[index + j * grid.wl_stride] += w * tally[q + j]
+
+
+@kernel
 def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
     """A crossing of tally level `level` (an in-water depth, or one of the air levels after
     them); beam: the packet is still part of the collimated solar beam."""
     w_over_mu = w * inverse_mu(uz, grid.mu_cut, beam)
     at = grid.flux + 4 * level
-    if uz > 0.0:
-        tally[at + FLUX_ED] += w
-        tally[at + FLUX_EOD] += w_over_mu
-    else:
-        tally[at + FLUX_EU] += w
-        tally[at + FLUX_EOU] += w_over_mu
+    plane = at + (FLUX_ED if uz > 0.0 else FLUX_EU)
+    scalar = at + (FLUX_EOD if uz > 0.0 else FLUX_EOU)
+    quad = -1
     if grid.radiance_on:
         band = theta_band_fast(grid, gf, gi, uz)
         col = 0 if gi[grid.theta_is_cap + band] else phi_band_fast(grid, gf, ux, uy)
-        tally[grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col] += w_over_mu
+        quad = grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col
+    if grid.n_wl == 1:
+        tally[plane] += w
+        tally[scalar] += w_over_mu
+        if quad >= 0:
+            tally[quad] += w_over_mu
+        return
+    q = grid.spectral + grid.n_wl
+    for j in range(grid.n_wl):
+        block = j * grid.wl_stride
+        share = tally[q + j]
+        tally[plane + block] += w * share
+        tally[scalar + block] += w_over_mu * share
+        if quad >= 0:
+            tally[quad + block] += w_over_mu * share

@@ -21,12 +21,16 @@ roulette_weight; optionally, scattering biased toward straight up (upward.py) an
 heavy packets. Analog mode decides each of these with a random draw instead. Either way every
 quantity has the same expectation; only the variance differs.
 
+A spectral scene traces all its wavelengths in one history (kernel/spectral.py): a hero
+wavelength per photon (p.wavelength) samples the path, and every wavelength's weight follows it;
+the events below call spectral.* only where grid.n_wl > 1.
+
 Every draw comes from the batch's own stream (kernel/rng.py), passed down as `rng`; it is
 kept apart from the PACKET record, so split copies do not copy it.
 """
 import math
 
-from . import local_estimate, upward
+from . import local_estimate, spectral, upward
 from .brdf import dispatch as brdf
 from .compile import batch, internal
 from .geometry import turn
@@ -36,7 +40,7 @@ from .phase import dispatch as phase
 from .rng import uniform
 from .sources import sky_direction
 from .surface import dispatch as surface_bsdf
-from .tally import score_crossing
+from .tally import score, score_crossing
 
 # what a free flight ends in
 FLIGHT_COLLISION = 0
@@ -140,7 +144,7 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
         p.w = w * (1.0 - r)
     if w_reflected > 0.0:
         score_crossing(grid, gf, gi, tally, air, w_reflected, rx, ry, rz, p.beam)
-        tally[grid.budget + BUDGET_SURFACE_REFLECTION] += w_reflected
+        score(grid, tally, grid.budget + BUDGET_SURFACE_REFLECTION, w_reflected)
     if reflected or p.w <= 0.0:
         return False
     p.ux = tx
@@ -160,8 +164,9 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
     times exp(-c dist), or survival with that probability in the analog walk)."""
     seg = p.seg
     layer = mi[medium.segment_layer + seg]
-    c = mf[medium.layer_c + layer]
-    albedo = mf[medium.layer_albedo + layer]
+    at = p.wavelength * medium.n_layers + layer
+    c = mf[medium.layer_c + at]
+    albedo = mf[medium.layer_albedo + at]
     uz = p.uz
     if uz > 0.0:
         target = seg + 1
@@ -174,11 +179,19 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
         dist = math.inf
     budget = grid.budget
     if albedo > 0.0:
-        s = tau * mf[medium.layer_inv_c + layer]
+        s = tau * mf[medium.layer_inv_c + at]
         if s < dist:
             p.z += s * uz
+            if grid.n_wl > 1:
+                spectral.flight(medium, mf, grid, tally, p, layer, s, True)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
+        if grid.n_wl > 1 and dist < math.inf:
+            spectral.flight(medium, mf, grid, tally, p, layer, dist, False)
+    elif grid.n_wl > 1:
+        spectral.attenuate(medium, mf, grid, tally, p, layer, dist)
+        if dist == math.inf:
+            return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
         # no scattering and no plane ahead: down an infinitely deep clear layer, or level
         tally[budget + ((BUDGET_LAYERS + layer) if c > 0.0 else BUDGET_LOST_BELOW)] += p.w
@@ -193,7 +206,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
             tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
             p.w *= transmitted
     if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
-        tally[budget + BUDGET_LOST_BELOW] += p.w
+        score(grid, tally, budget + BUDGET_LOST_BELOW, p.w)
         return FLIGHT_GONE, -1, 0.0
     p.z = mf[medium.plane_z + target]
     return FLIGHT_PLANE, target, tau
@@ -203,7 +216,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
 def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
-    albedo = mf[medium.layer_albedo + layer]
+    albedo = mf[medium.layer_albedo + p.wavelength * medium.n_layers + layer]
     w = p.w
     if est.directions_on or est.cap_on:
         local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p.seg,
@@ -213,6 +226,9 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
         if uniform(rng) >= albedo:
             tally[budget + BUDGET_LAYERS + layer] += w
             return False, 0.0
+    elif grid.n_wl > 1:
+        spectral.absorb(medium, mf, grid, tally, p, layer)
+        w = p.w
     else:
         scattered = w * albedo
         tally[budget + BUDGET_LAYERS + layer] += w - scattered
@@ -221,8 +237,11 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
         w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz, rng)
     else:
         u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
-        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, uniform(rng))
+        cos_s = phase.sample_cos(medium, mf, mi, layer, p.wavelength, u_pick, uniform(rng))
         ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
+        if grid.n_wl > 1:
+            spectral.turn(medium, mf, mi, grid, tally, p, layer, cos_s)
+            w = p.w
     p.w = w
     p.ux = ux
     p.uy = uy
@@ -232,7 +251,7 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
     if not survives_roulette(ctrl, p, rng):
         return False, tau
     if events >= ctrl.max_events:
-        tally[budget + BUDGET_TRUNCATED] += p.w
+        score(grid, tally, budget + BUDGET_TRUNCATED, p.w)
         return False, tau
     return True, tau
 
@@ -259,7 +278,7 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
         air = grid.air_level
         score_crossing(grid, gf, gi, tally, air, leaving, tx, ty, tz, p.beam)
         score_crossing(grid, gf, gi, tally, air + 1, leaving, tx, ty, tz, p.beam)
-        tally[grid.budget + BUDGET_WATER_LEAVING] += leaving
+        score(grid, tally, grid.budget + BUDGET_WATER_LEAVING, leaving)
     if not goes_on:
         return False
     p.ux = rx
@@ -277,7 +296,7 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
     whether the packet goes on."""
     budget = grid.budget
     if not bottom.reflects:  # black (an infinitely deep bottom is never met)
-        tally[budget + BUDGET_BOTTOM] += p.w
+        score(grid, tally, budget + BUDGET_BOTTOM, p.w)
         return False
     if est.directions_on or est.cap_on:
         local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
@@ -292,6 +311,8 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
         if uniform(rng) >= rho:
             tally[budget + BUDGET_BOTTOM] += p.w
             return False
+    elif grid.n_wl > 1:
+        spectral.reflect(grid, gf, tally, p, rho)
     else:
         tally[budget + BUDGET_BOTTOM] += p.w * (1.0 - rho)
         p.w *= rho
@@ -379,8 +400,10 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         launch(p, w, ux, uy, uz, not from_sky)
-        if (i < 0 or from_sky or not beam_once) and not enter_from_air(surface, ctrl, grid, gf, gi,
-                                                                tally, p, rng):
+        from_air = i < 0 or from_sky or not beam_once
+        if grid.n_wl > 1:
+            spectral.start(grid, gf, tally, p, from_sky, from_air, rng)
+        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz

@@ -37,7 +37,7 @@ def scatter(medium, mf, mi, layer, w, ux, uy, uz, rng):
         nx, ny, nz = sin_t * cp, sin_t * sp, -mu
     else:
         u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
-        cos_s = phase.sample_cos(medium, mf, mi, layer, u_pick, uniform(rng))
+        cos_s = phase.sample_cos(medium, mf, mi, layer, 0, u_pick, uniform(rng))
         nx, ny, nz = turn(ux, uy, uz, cos_s, uniform(rng))
     keep = mf[medium.up_keep + layer]
     if -nz > up_cos:

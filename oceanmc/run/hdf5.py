@@ -23,7 +23,8 @@ COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is
                "batch": ("1", "independent batch index"),
                "direction": ("1", "index of a local-estimate direction"),
                "direction_theta": ("deg", "theta of travel of each local-estimate direction"),
-               "direction_phi": ("deg", "phi of travel of each local-estimate direction")}
+               "direction_phi": ("deg", "phi of travel of each local-estimate direction"),
+               "wavelength": ("nm", "wavelength in vacuum; spectral scenes only")}
 
 
 # a partial run's unfinished batches (run/simulation.py), what --resume continues them from
@@ -145,7 +146,7 @@ def load_result(path: str | Path) -> Result:
     path = Path(path)
     with h5py.File(path, "r") as f:
         attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
-        coords = {name: f[name][()] for name in COORD_UNITS if name != "batch"}
+        coords = {name: f[name][()] for name in COORD_UNITS if name != "batch" and name in f}
         quantities = {}
 
         def visit(name, obj):

@@ -356,6 +356,19 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     return Result(coords, q, attrs)
 
 
+def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
+    """One Result from the per-wavelength Results of a spectral run: every quantity gains a
+    leading `wavelength` dimension (nm; the coordinate `wavelength`), after the batch axis."""
+    first = parts[0]
+    quantities = {
+        name: Quantity(name, ("wavelength",) + q.dims,
+                       np.stack([p.quantities[name].batches for p in parts], axis=1),
+                       q.units, q.description)
+        for name, q in first.quantities.items()}
+    coords = dict(first.coords, wavelength=np.asarray(wavelengths, dtype=np.float64))
+    return Result(coords, quantities, dict(first.attrs))
+
+
 # --- the printed summary -----------------------------------------------------------------------
 
 def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
@@ -387,6 +400,34 @@ def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
     return rows
 
 
+# the columns of a spectral run's table: (heading, quantity, depth index or None)
+SPECTRAL_COLUMNS = (("Rrs nadir", "air/Rrs_nadir", None), ("Eu(0+)", "air/Eu", None),
+                    ("Ed(z1)", "Ed", 0), ("Eu(z1)", "Eu", 0), ("Eo(z1)", "Eo", 0),
+                    ("leaving", "budget/water_leaving", None), ("total", "budget/total", None))
+
+
+def format_spectrum(result: Result) -> list[str]:
+    """A spectral run as a table: one row per wavelength, the headline quantities in columns
+    (z1: the first tally depth), each value with its relative standard error in %."""
+    depths = result.coords["depth"]
+    first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
+    columns = [(head.replace("z1", first), name, index)
+               for head, name, index in SPECTRAL_COLUMNS if name in result]
+    lines = [f"  {'nm':>6}" + "".join(f" {head:>15}" for head, _, _ in columns)]
+    for k, wavelength in enumerate(result.coords["wavelength"]):
+        cells = []
+        for _, name, index in columns:
+            value, err = result[name][k], result.stderr(name)[k]
+            if index is not None:
+                value, err = value[index], err[index]
+            rel = abs(err / value) if value != 0.0 else 0.0
+            cells.append(f"{value:>9.4g} {rel:>5.1%}")
+        lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>15}" for cell in cells))
+    lines.append("  (value and relative standard error; budget fractions of Ed(0+); every "
+                 "quantity per wavelength in the file)")
+    return lines
+
+
 def format_summary(result: Result) -> str:
     a = result.attrs
     lines = [
@@ -394,8 +435,10 @@ def format_summary(result: Result) -> str:
         f"  {a['photons']:,} photons in {a['batches']} batches on {a['threads']} thread(s): "
         f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
         f"(start-up {a['startup_time_s']:.2f} s)",
-        f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}",
     ]
+    if "wavelength" in result.coords:
+        return "\n".join(lines + format_spectrum(result))
+    lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}")
     for label, units, value, err in summary_rows(result):
         rel = abs(err / value) if value != 0.0 else 0.0
         lines.append(f"  {label:<28}{units:<9}{value:>13.6g}{err:>12.3g}{rel:>10.2%}")

@@ -23,14 +23,14 @@ import numpy as np
 from tqdm import tqdm
 
 from .. import __version__, scene
-from ..optics import iops_table, monochromatic_illumination
+from ..optics import iops_table, illumination_spectrum
 from ..config import SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_views
 from .compiling import ready
-from .results import Result, from_tallies, sun_of
+from .results import Result, from_tallies, stack_wavelengths, sun_of
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
@@ -98,7 +98,6 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_batches = config.batches - first_batch
     n_per_batch = math.ceil(config.photons / config.batches)
     n_layers = len(config.water.layers)
-    ed0 = monochromatic_illumination(config).Ed0
     config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
     depths = config.tallies.depths_m
     # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
@@ -119,7 +118,9 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
     stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
-    raw = dict(tally_views(sc.grid, tallies), events=events)
+    n_wl = len(config.wavelengths)
+    raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
+    ed0 = illumination_spectrum(config)[0]
     args = sc.kernel_args()
     # a batch's lock is held through each of its calls, so that a checkpoint copies its state
     # between two calls
@@ -178,18 +179,25 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "wall_time_s": wall,
             "startup_time_s": startup,
             "photons_per_s": photons / wall if wall > 0 else float("inf"),
-            "scattering_events": int(raw["events"][:done].sum()),
+            "scattering_events": int(events[:done].sum()),
         }
-        part = {name: values[:done] for name, values in raw.items()}
-        part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+        # local estimates (and so the reflected light in exact view directions) are
+        # monochromatic only: a spectral scene has none (config/scene.py refuses them)
         reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
-        if reflected is not None:
-            part["reflected_local"] = reflected
-        result = from_tallies(part, sc.angles, np.array(depths), n_per_batch,
-                              ed0, n_layers, config.tallies.radiance, attrs,
-                              config.tallies.local_directions_deg, sc.local_rows,
-                              config.nadir_local, sun_of(config))
+        per_wavelength = []
+        for k, raw in enumerate(raws):
+            part = {name: values[:done] for name, values in raw.items()}
+            part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+            if reflected is not None:
+                part["reflected_local"] = reflected
+            per_wavelength.append(from_tallies(
+                part, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
+                config.tallies.radiance, attrs, config.tallies.local_directions_deg,
+                sc.local_rows, config.nadir_local, sun_of(config)))
+        # one wavelength: the monochromatic layout (no wavelength dimension)
+        result = per_wavelength[0] if n_wl == 1 else \
+            stack_wavelengths(per_wavelength, config.wavelengths)
         result.resume_state = state
         result.iops = iops_table(sc.layers, config.wavelengths)
         return result

@@ -70,9 +70,12 @@ def build(config: cfg.SceneConfig) -> Scene:
     surf = surface.pack(config.surface, config.n_water)
     bot, bp = bottom.pack(config.bottom)
     sk, sf = sky.pack(optics.monochromatic_illumination(config))
+    # the sky's share of the photons: the wavelengths' mean diffuse fraction (grid.source_q
+    # gives each wavelength its own)
+    sk[0]["diffuse_fraction"] = grid.stratified_fraction(optics.illumination_spectrum(config)[1])
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]), len(column.albedo))
+                                   len(directions[0]), len(column.albedo), column.max_comps)
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
                  pack_estimator(config.estimator, column.albedo), angles, local_rows,

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
+from .. import optics
 from ..kernel import models
 from ..kernel.records import GRID, Pool, record
 
@@ -69,12 +70,35 @@ def theta_lookup(mu: np.ndarray) -> np.ndarray:
     return np.clip(bands, 0, len(mu) - 2).astype(np.int64)
 
 
+def stratified_fraction(diffuse_fraction: np.ndarray) -> float:
+    """The share of a batch's photons that come from the sky (kernel/transport.py): the mean
+    of the wavelengths' diffuse fractions, so that each source is sampled in proportion to its
+    mean share of Ed0."""
+    return float(np.mean(diffuse_fraction))
+
+
+def source_shares(diffuse_fraction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(source_q (2, n_wl), source_scale (2,)): each wavelength's weight of a sun (row 0) or sky
+    (row 1) photon relative to the weight the stratification gives it, (1 - f_l) / (1 - f) and
+    f_l / f (f: stratified_fraction), as shares of their largest (kernel/spectral.py)."""
+    f = stratified_fraction(diffuse_fraction)
+    sun = (1.0 - diffuse_fraction) / (1.0 - f) if f < 1.0 else np.ones_like(diffuse_fraction)
+    sky = diffuse_fraction / f if f > 0.0 else np.ones_like(diffuse_fraction)
+    rows = np.array([sun, sky])
+    scale = rows.max(axis=1)
+    return rows / scale[:, None], scale
+
+
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int,
-         n_layers: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
+         surface_level: int, n_dirs: int, n_layers: int, max_comps: int = 1,
+         bottom_shares: np.ndarray | None = None
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
-    (a depth profile's sublayers each absorb into a budget column of their own)."""
+    (a depth profile's sublayers each absorb into a budget column of their own). A spectral
+    scene's row holds the packet's spectral state first (max_comps: phase components of the
+    layer with most), then one block per wavelength; bottom_shares: each wavelength's bottom
+    reflectance relative to the packed BRDF's (default 1)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
@@ -82,16 +106,25 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     radiance_on = bool(config.tallies.radiance)
     theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
     n_budget = models.BUDGET_LAYERS + n_layers
+    n_wl = len(config.wavelengths)
     layout = {}
-    size = 0
+    # the packet's spectral state (m, q per wavelength, then phase-component values)
+    size = spectral_size = 2 * n_wl + max_comps if n_wl > 1 else 0
     for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
                          ("local", (n_depths + 1) * n_dirs), ("cap", n_depths + 1),
                          ("budget", n_budget)):
         layout[name] = size
         size += length
+    wl_stride = size - spectral_size
+    size = spectral_size + n_wl * wl_stride
+    _, diffuse, _ = optics.illumination_spectrum(config)
+    source_q, source_scale = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
-        GRID, n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
+        GRID, n_wl=n_wl, wl_stride=wl_stride, spectral=0, source_q=f.add(source_q),
+        source_scale=f.add(source_scale),
+        bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
+        n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
         mu_cut=float(config.tallies.grazing_mu_cut), radiance_on=int(radiance_on),
         n_theta=len(grid.theta), n_phi=int(config.tallies.phi_bands),
         n_lookup=THETA_LOOKUP_CELLS, theta_cols=theta_cols, phi_cols=phi_cols,
@@ -103,15 +136,18 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     return rec, f.array(), i.array(), grid
 
 
-def tally_views(grid_record: np.ndarray, tallies: np.ndarray) -> dict[str, np.ndarray]:
+def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
+                wavelength: int = 0) -> dict[str, np.ndarray]:
     """The per-batch tally rows (batch, size) as named arrays with a batch axis first: flux
-    (level, 4), radiance (level, theta, phi), local (level, direction), cap (level), budget."""
+    (level, 4), radiance (level, theta, phi), local (level, direction), cap (level), budget;
+    those of wavelength index `wavelength` in a spectral scene."""
     g = grid_record[0]
     nb = tallies.shape[0]
     n_levels = int(g["n_depths"]) + 2
+    block = wavelength * int(g["wl_stride"])
 
     def part(name, length, shape):
-        at = int(g[name])
+        at = int(g[name]) + block
         return tallies[:, at:at + length].reshape((nb,) + shape)
 
     n_dirs = int(g["n_dirs"])

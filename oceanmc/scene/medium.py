@@ -27,6 +27,7 @@ class Column:
     albedo: np.ndarray         # per layer
     layers: tuple              # optics.LayerIOPs of each layer (a depth profile is resolved
     #                            into several layers of one configured layer)
+    max_comps: int             # phase-function components in the layer that has most
 
 
 def _mixture(phase: cfg.Mixture) -> list:
@@ -100,48 +101,80 @@ def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray
     return fraction
 
 
+def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> None:
+    """What the one-history spectral walk (kernel/spectral.py) does not carry: one line each."""
+    est = config.estimator
+    for key, value, off in (("estimator.mode", est.mode, "implicit"),
+                            ("estimator.split_weight", est.split_weight, None),
+                            ("estimator.upward_fraction", est.upward_fraction, None)):
+        if value != off:
+            raise cfg.ConfigError(f"{key} = {value!r} with {len(config.wavelengths)} wavelengths: "
+                                  f"the spectral walk needs {key} = {off!r}")
+    if config.tallies.local_directions_deg or config.tallies.nadir_estimator == "local":
+        raise cfg.ConfigError("tallies.local_directions_deg / nadir_estimator = 'local' with "
+                              "several wavelengths: local estimates are monochromatic in this "
+                              "build; use nadir_estimator: crossing (auto does) and the quads")
+    for layer in layers:
+        scatters = layer.b > 0.0
+        if scatters.any() and not scatters.all():
+            raise cfg.ConfigError(
+                f"water.layers[{layer.config_layer}].b is 0 at some wavelengths and not at "
+                "others: the spectral walk needs a layer to scatter at every wavelength or at "
+                "none (give a small b > 0)")
+
+
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
-    """(MEDIUM record, float pool, int pool, Column)."""
+    """(MEDIUM record, float pool, int pool, Column). Per-wavelength tables have one row per
+    wavelength; the Column's optical depths and albedo are those of the first wavelength (the
+    local estimates, which only monochromatic scenes use, read them)."""
     layers = optics.column_iops(config)
-    if len(config.wavelengths) > 1:
-        raise cfg.ConfigError(f"wavelengths_nm has {len(config.wavelengths)} entries: this "
-                              "build traces one wavelength at a time; give one")
-    comp_start, comp_count, cumweight, comp_model, comp_params = [], [], [], [], []
+    n_wl = len(config.wavelengths)
+    if n_wl > 1:
+        _spectral_checks(config, layers)
+    comp_start, comp_count, shares, comp_model, comp_params = [], [], [], [], []
     tab_start, tab_len, psi_parts, q_parts, cdf_parts = [], [], [], [], []
     tab_offset = 0
     table_at: dict[int, tuple[int, int]] = {}
     for layer in layers:
-        comps = [(share * w, m, p, t) for phase, share in zip(layer.phases, layer.weights[0])
-                 if share > 0.0 for w, m, p, t in phase_components(phase)]
+        # the components of every phase that scatters at some wavelength; each wavelength
+        # weights them by its own shares (a row of zeros for phases it does not use)
+        used = [k for k in range(len(layer.phases)) if layer.weights[:, k].max() > 0.0]
         comp_start.append(len(comp_model))
-        comp_count.append(len(comps))
-        total = sum(w for w, *_ in comps)
-        running = 0.0
-        for weight, model, params, table in comps:
-            running += weight / total
-            cumweight.append(running)
-            comp_model.append(model)
-            comp_params.append(list(params) + [0.0] * (2 - len(params)))
-            if table is None:
-                tab_start.append(0)
-                tab_len.append(0)
-                continue
-            key = id(table[0])
-            if key not in table_at:
-                table_at[key] = (tab_offset, len(table[0]))
-                psi_parts.append(table[0])
-                q_parts.append(table[1])
-                cdf_parts.append(table[2])
-                tab_offset += len(table[0])
-            tab_start.append(table_at[key][0])
-            tab_len.append(table_at[key][1])
-        cumweight[-1] = 1.0
+        for k in used:
+            for weight, model, params, table in phase_components(layer.phases[k]):
+                shares.append(layer.weights[:, k] * weight)
+                comp_model.append(model)
+                comp_params.append(list(params) + [0.0] * (2 - len(params)))
+                if table is None:
+                    tab_start.append(0)
+                    tab_len.append(0)
+                    continue
+                key = id(table[0])
+                if key not in table_at:
+                    table_at[key] = (tab_offset, len(table[0]))
+                    psi_parts.append(table[0])
+                    q_parts.append(table[1])
+                    cdf_parts.append(table[2])
+                    tab_offset += len(table[0])
+                tab_start.append(table_at[key][0])
+                tab_len.append(table_at[key][1])
+        comp_count.append(len(comp_model) - comp_start[-1])
+    # cumulative shares within each layer, one row per wavelength, the last exactly 1
+    share = np.array(shares).T.reshape(n_wl, len(comp_model))
+    cumweight = np.empty_like(share)
+    for first, count in zip(comp_start, comp_count):
+        part = share[:, first:first + count]
+        total = part.sum(axis=1, keepdims=True)
+        part = np.where(total > 0.0, part / np.where(total > 0.0, total, 1.0), 1.0 / count)
+        cumweight[:, first:first + count] = np.cumsum(part, axis=1)
+        cumweight[:, first + count - 1] = 1.0
 
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
-    layer_c = np.array([layer.c[0] for layer in layers], dtype=np.float64)
-    albedo = np.array([layer.b[0] / layer.c[0] if layer.b[0] > 0.0 else 0.0
-                       for layer in layers], dtype=np.float64)
-    plane_tau = optical_depths(plane_z, segment_layer, layer_c)
+    layer_c = np.array([layer.c for layer in layers], dtype=np.float64).T     # (n_wl, n_layers)
+    layer_b = np.array([layer.b for layer in layers], dtype=np.float64).T
+    albedo_all = np.divide(layer_b, layer_c, out=np.zeros_like(layer_c), where=layer_b > 0.0)
+    albedo = albedo_all[0]
+    plane_tau = optical_depths(plane_z, segment_layer, layer_c[0])
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
                          dtype=np.float64)
     fraction = upward_fractions(config.estimator, albedo)
@@ -151,11 +184,12 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
 
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
-        MEDIUM, n_planes=len(plane_z), n_layers=len(layers), up_cos=up_cos,
+        MEDIUM, n_planes=len(plane_z), n_layers=len(layers), n_wl=n_wl,
+        n_comps=len(comp_model), up_cos=up_cos,
         plane_z=f.add(plane_z), plane_tau=f.add(plane_tau), layer_c=f.add(layer_c),
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
-        layer_albedo=f.add(albedo), up_fraction=f.add(fraction),
+        layer_albedo=f.add(albedo_all), up_fraction=f.add(fraction),
         up_density=f.add(fraction / up_solid_angle),
         up_keep=f.add(1.0 - fraction), comp_cumweight=f.add(cumweight),
         comp_params=f.add(comp_params),
@@ -166,5 +200,5 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_start=i.add(comp_start), comp_count=i.add(comp_count),
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
         comp_tab_len=i.add(tab_len))
-    column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
+    column = Column(surface_level, depths, level_tau, albedo, tuple(layers), max(comp_count))
     return rec, f.array(), i.array(), column

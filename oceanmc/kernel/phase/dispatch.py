@@ -52,20 +52,46 @@ def evaluate_component(medium, mf, mi, k, cos_psi):
 
 
 @hot
-def sample_cos(medium, mf, mi, layer, u_pick, u):
-    """cos(psi) from the layer's phase function; u_pick chooses the component of a mixture with
-    probability b_k / b (it is ignored for a single component, so the caller need not draw it),
-    u the angle."""
+def sample_cos(medium, mf, mi, layer, wavelength, u_pick, u):
+    """cos(psi) from the layer's phase function at wavelength index `wavelength`; u_pick chooses
+    the component of a mixture with probability b_k / b (it is ignored for a single component,
+    so the caller need not draw it), u the angle."""
     k = mi[medium.comp_start + layer]
     last = k + mi[medium.comp_count + layer] - 1
-    while k < last and u_pick >= mf[medium.comp_cumweight + k]:
+    cumweight = medium.comp_cumweight + wavelength * medium.n_comps
+    while k < last and u_pick >= mf[cumweight + k]:
         k += 1
     return sample_component(medium, mf, mi, k, u)
 
 
+@kernel
+def evaluate_components(medium, mf, mi, layer, cos_psi, out, at):
+    """Each component of the layer at cos_psi (1/sr) into out[at], out[at + 1], ... (once per
+    collision, for every wavelength's mixture; kernel/spectral.py)."""
+    first = mi[medium.comp_start + layer]
+    for k in range(mi[medium.comp_count + layer]):
+        out[at + k] = evaluate_component(medium, mf, mi, first + k, cos_psi)
+
+
+@kernel
+def mixture_at(medium, mf, mi, layer, wavelength, values, at):
+    """The layer's phase function at wavelength index `wavelength`: its shares of the component
+    values that evaluate_components left in values[at:]."""
+    first = mi[medium.comp_start + layer]
+    cumweight = medium.comp_cumweight + wavelength * medium.n_comps + first
+    total = 0.0
+    previous = 0.0
+    for k in range(mi[medium.comp_count + layer]):
+        weight = mf[cumweight + k] - previous
+        previous = mf[cumweight + k]
+        total += weight * values[at + k]
+    return total
+
+
 @hot
 def evaluate(medium, mf, mi, layer, cos_psi):
-    """The layer's phase function p(cos_psi) in 1/sr: the b-weighted sum of its components."""
+    """The layer's phase function p(cos_psi) in 1/sr: the b-weighted sum of its components (at
+    the first wavelength: local estimates and the upward bias are monochromatic)."""
     first = mi[medium.comp_start + layer]
     total = 0.0
     previous = 0.0

@@ -1,0 +1,143 @@
+"""All wavelengths in one photon history (kernel/spectral.py): every wavelength of a spectral run
+against an independent single-wavelength run of the same scene (z against both standard errors,
+Bonferroni bound over the values compared, fixed seeds), energy closure per wavelength, the
+sun/sky shares of a spectral illumination, the results' wavelength dimension and the scenes the
+spectral walk refuses."""
+import copy
+
+import numpy as np
+import pytest
+
+import oceanmc
+from oceanmc.config import ConfigError
+
+from stats_helpers import assert_z, dof_of
+
+THREADS = 2
+WAVELENGTHS = [440.0, 550.0, 670.0]
+# one 4 m layer whose a, b and Fournier-Forand backscatter fraction all change with wavelength
+# (so the free paths, albedos and phase functions of the wavelengths differ), over sand
+SCENE = {
+    "name": "three wavelengths over sand",
+    "photons": 80_000, "batches": 16, "seed": 11,
+    "wavelengths_nm": WAVELENGTHS,
+    "illumination": {"sun_zenith_deg": 40, "diffuse_fraction": 0.3},
+    "water": {"layers": [{"thickness_m": 4.0, "a": [0.03, 0.08, 0.5], "b": [0.6, 0.45, 0.3],
+                          "bb_ratio": [0.03, 0.02, 0.01]}]},
+    "bottom": {"model": "lambertian", "reflectance": 0.3},
+    "tallies": {"depths_m": [0, 2, 4], "nadir_estimator": "crossing"},
+}
+COMPARED = ("Ed", "Eu", "Eo", "air/Eu", "budget/water_leaving", "budget/absorbed_bottom",
+            "budget/absorbed_layer_1")
+
+
+def single(config: dict, k: int, seed: int) -> dict:
+    """The same scene at wavelength k alone."""
+    out = copy.deepcopy(config)
+    out["wavelengths_nm"] = [config["wavelengths_nm"][k]]
+    out["seed"] = seed
+    out["photons"] = 40_000
+    layer = out["water"]["layers"][0]
+    for key in ("a", "b", "bb_ratio"):
+        if isinstance(layer.get(key), list):
+            layer[key] = [layer[key][k]]
+    return out
+
+
+def compare_with_singles(config: dict, compared=COMPARED) -> None:
+    spectral = oceanmc.simulate(config, threads=THREADS)
+    singles = [oceanmc.simulate(single(config, k, 100 + k), threads=THREADS)
+               for k in range(len(config["wavelengths_nm"]))]
+    n_compared = sum(spectral[name].size for name in compared)
+    for name in compared:
+        reference = np.stack([s[name] for s in singles])
+        ref_se = np.stack([s.stderr(name) for s in singles])
+        assert_z(spectral[name], reference, np.hypot(spectral.stderr(name), ref_se),
+                 n_compared=n_compared, dof=dof_of(spectral), rel_max=0.1, abs_max=2e-3,
+                 what=name)
+    # energy closure at every wavelength
+    assert_z(spectral["budget/total"], 1.0, spectral.stderr("budget/total"),
+             dof=dof_of(spectral), abs_max=3e-3, what="budget/total")
+
+
+def test_one_history_matches_single_wavelength_runs():
+    compare_with_singles(SCENE)
+
+
+def test_one_history_matches_single_wavelength_runs_deep_turbid():
+    config = copy.deepcopy(SCENE)
+    config["water"]["layers"] = [{"thickness_m": float("inf"), "a": [0.9, 0.4, 0.7],
+                                  "b": [3.0, 2.6, 2.2], "bb_ratio": 0.018}]
+    config["bottom"] = {"model": "none"}
+    config["tallies"]["depths_m"] = [0, 1, 3]
+    compare_with_singles(config, tuple(n for n in COMPARED if n != "budget/absorbed_bottom"))
+
+
+def test_spectral_illumination_sun_and_sky_shares(tmp_path):
+    """Ed0 and the diffuse fraction per wavelength (a spectrum file): Ed(0+) is Ed0 at every
+    wavelength, and Ed(0-), Eu(0-) match the single-wavelength runs with the same spectrum."""
+    table = tmp_path / "sky.csv"
+    table.write_text("wavelength_nm,Ed0,diffuse_fraction\n400,1.2,0.6\n700,0.8,0.05\n")
+    config = copy.deepcopy(SCENE)
+    config["illumination"] = {"sun_zenith_deg": 40,
+                              "spectrum": {"model": "table", "file": str(table)}}
+    spectral = oceanmc.simulate(config, threads=THREADS)
+    ed0 = np.interp(WAVELENGTHS, [400, 700], [1.2, 0.8])
+    np.testing.assert_allclose(spectral["air/Ed"], ed0, rtol=1e-9)
+    singles = [oceanmc.simulate(single(config, k, 200 + k), threads=THREADS) for k in range(3)]
+    for name in ("Ed", "Eu"):
+        reference = np.stack([s[name] for s in singles])
+        ref_se = np.stack([s.stderr(name) for s in singles])
+        assert_z(spectral[name], reference, np.hypot(spectral.stderr(name), ref_se),
+                 n_compared=18, dof=dof_of(spectral), rel_max=0.1, what=name)
+
+
+def test_wavelength_dimension_and_monochromatic_layout(tmp_path):
+    """A spectral file has a leading wavelength dimension (nm) that xarray names; a scene
+    without wavelengths_nm keeps today's layout; one wavelength runs the monochromatic walk
+    and keeps the monochromatic layout (the same numbers as the scene without wavelengths_nm)."""
+    xr = pytest.importorskip("xarray")
+    config = copy.deepcopy(SCENE)
+    config["photons"] = 4000
+    spectral = oceanmc.simulate(config, threads=THREADS)
+    assert spectral.quantities["radiance"].dims == ("wavelength", "depth", "theta", "phi")
+    spectral.save(tmp_path / "s.h5")
+    ds = xr.open_dataset(tmp_path / "s.h5", engine="h5netcdf")
+    assert ds["Ed"].dims == ("wavelength", "depth")
+    np.testing.assert_array_equal(ds["wavelength"].values, WAVELENGTHS)
+    air = xr.open_dataset(tmp_path / "s.h5", engine="h5netcdf", group="air")
+    assert air["Rrs_nadir"].dims == ("wavelength",)
+    assert air["Rrs_nadir_stderr"].dims == ("wavelength",)
+    assert oceanmc.load_result(tmp_path / "s.h5").coords["wavelength"].tolist() == WAVELENGTHS
+
+    mono = single(config, 1, 7)
+    mono["photons"] = 4000
+    one = oceanmc.simulate(mono, threads=THREADS)
+    plain = copy.deepcopy(mono)
+    del plain["wavelengths_nm"]
+    for key in ("a", "b", "bb_ratio"):
+        plain["water"]["layers"][0][key] = plain["water"]["layers"][0][key][0]
+    bare = oceanmc.simulate(plain, threads=THREADS)
+    assert "wavelength" not in bare.coords
+    assert bare.quantities["Ed"].dims == ("depth",)
+    assert one.quantities["Ed"].dims == ("depth",)   # one wavelength: monochromatic layout
+    np.testing.assert_array_equal(one["radiance"], bare["radiance"])
+    bare.save(tmp_path / "m.h5")
+    assert "wavelength" not in xr.open_dataset(tmp_path / "m.h5", engine="h5netcdf").dims
+
+
+@pytest.mark.parametrize("change, key", [
+    ({"estimator": {"mode": "analog"}}, "estimator.mode"),
+    ({"estimator": {"split_weight": 2.0}}, "estimator.split_weight"),
+    ({"estimator": {"upward_fraction": 0.1}}, "estimator.upward_fraction"),
+    ({"tallies": {"depths_m": [0], "local_directions_deg": [[180, 0]]}},
+     "local_directions_deg"),
+    ({"water": {"layers": [{"thickness_m": 4.0, "a": 0.1, "b": [0.3, 0.0, 0.2]}]}},
+     "water.layers[0].b"),
+])
+def test_spectral_walk_refuses_what_it_does_not_carry(change, key):
+    config = copy.deepcopy(SCENE)
+    config.update(change)
+    with pytest.raises(ConfigError, match=key.replace("[", r"\[").replace("]", r"\]")) as info:
+        oceanmc.simulate(config, threads=THREADS)
+    assert "\n" not in str(info.value)
