@@ -67,12 +67,12 @@ import math
 import os
 import sys
 import tempfile
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from .phase_tables import TableError
+from .phase_tables import (ARRAY_FILE_ERRORS, TableError, bounded_npy, hdf5_arrays,
+                           npz_arrays)
 
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
 HC_GAUSS = 8              # Gauss points per cell side for its cell averages
@@ -219,25 +219,6 @@ def _edges(path, data: dict, name: str, n: int, span: tuple[float, float] | None
     return e
 
 
-MAX_MAP_VALUES = 10**8   # 800 MB of float64: far beyond any sky map, and refused before loading
-
-
-def _bounded_npy(file, name: str) -> np.ndarray:
-    """The array of an .npy stream, its header's shape checked against MAX_MAP_VALUES first (a
-    header may claim 10^10 values in a file of a few bytes)."""
-    readers = {(1, 0): np.lib.format.read_array_header_1_0,
-               (2, 0): np.lib.format.read_array_header_2_0}
-    version = np.lib.format.read_magic(file)
-    if version not in readers:
-        raise ValueError(f"{name}: .npy format version {version} not supported")
-    shape, _, _ = readers[version](file)
-    if math.prod(shape) > MAX_MAP_VALUES:
-        raise ValueError(f"{name}: its header claims shape {shape}, more than "
-                         f"{MAX_MAP_VALUES:,} values")
-    file.seek(0)
-    return np.lib.format.read_array(file, allow_pickle=False)
-
-
 def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(theta_edges_deg, phi_edges_deg, radiance (n_theta, n_phi)) of a sky map file, checked;
@@ -252,30 +233,18 @@ def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
     if suffix == ".npy":
         try:
             with open(path, "rb") as file:
-                data[dataset] = _bounded_npy(file, dataset)
-        except (OSError, ValueError, EOFError) as exc:
+                data[dataset] = bounded_npy(file, dataset)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as .npy ({exc})")
     elif suffix == ".npz":
         try:
-            with zipfile.ZipFile(path) as archive:
-                for member in archive.namelist():
-                    with archive.open(member) as file:
-                        data[member.removesuffix(".npy")] = _bounded_npy(file, member)
-        except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError) as exc:
+            data = npz_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as .npz ({exc})")
     elif suffix in (".h5", ".hdf5", ".he5"):
-        import h5py
         try:
-            with h5py.File(path, "r") as h5:
-                for k in h5.keys():
-                    if not isinstance(h5.get(k, getlink=True), h5py.HardLink):
-                        continue  # a soft or external link may dangle or leave the file
-                    if isinstance(h5[k], h5py.Dataset):
-                        if h5[k].size > MAX_MAP_VALUES:
-                            raise ValueError(f"{k} holds {h5[k].size:,} values, more than "
-                                             f"{MAX_MAP_VALUES:,}")
-                        data[k] = np.asarray(h5[k][()])
-        except (OSError, ValueError, TypeError, KeyError) as exc:
+            data = hdf5_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as HDF5 ({exc})")
     elif suffix == ".exr":
         data[dataset] = _read_exr(path, dataset, layout)
