@@ -1,5 +1,5 @@
-"""Malformed sky map files: one TableError naming the file, never a traceback or a huge
-allocation (an .npy header may claim 10^10 values in a file of a few bytes)."""
+"""Malformed sky map and BRDF table files: one TableError naming the file, never a traceback
+or a huge allocation (an .npy header may claim 10^10 values in a file of a few bytes)."""
 import zipfile
 
 import h5py
@@ -69,3 +69,15 @@ def test_string_array_is_refused(tmp_path):
     np.save(path, np.array([["a", "b"], ["c", "d"]]))
     with pytest.raises(TableError, match="not real numbers"):
         read_sky_map(path)
+
+
+def test_brdf_table_uses_the_same_bounded_reader(tmp_path):
+    from oceanmc.scene.brdf_tables import _load_arrays
+    path = tmp_path / "brdf.npz"
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("brdf.npy", _huge_npy_header())
+    with pytest.raises(TableError, match=r"BRDF table .*brdf.npz.*claims shape"):
+        _load_arrays(path)
+    path.write_bytes(b"PK\x03\x04 broken")
+    with pytest.raises(TableError, match="cannot read it as .npz"):
+        _load_arrays(path)
