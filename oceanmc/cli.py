@@ -223,8 +223,8 @@ def cmd_show(args: argparse.Namespace) -> int:
         raise UsageError(f"{path}: no such file")
     try:
         result = load_result(path)
-    except (OSError, KeyError, ValueError) as exc:
-        raise UsageError(f"{path}: not an oceanmc results file ({exc})") from None
+    except ValueError as exc:  # ResultsFileError: one line saying what is wrong
+        raise UsageError(f"{path}: {exc}") from None
     print(format_summary(result))
     if args.config:
         print(result.config_yaml)

@@ -85,6 +85,7 @@ def test_crafted_file_is_refused_in_one_line(saved, tmp_path, case, capsys):
         assert main(argv) == 2
         err = capsys.readouterr().err.strip()
         assert err.count("\n") == 0 and expected.split()[0] in err and "Traceback" not in err
+        assert err.count("results file") <= 1  # said once, not nested
 
 
 def test_truncated_and_garbage_files_are_refused(saved, tmp_path, capsys):

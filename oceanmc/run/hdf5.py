@@ -168,7 +168,7 @@ def load_result(path: str | Path) -> Result:
         # h5py reports a missing dataset, a dangling or external link, a truncated file as
         # OSError/KeyError; a wrong dtype or shape surfaces as ValueError/TypeError below
         detail = " ".join(str(exc).split()) or type(exc).__name__
-        raise ResultsFileError(f"not a readable oceanmc results file ({detail[:200]})") from None
+        raise ResultsFileError(f"not an oceanmc results file ({detail[:200]})") from None
 
 
 def _dataset(group: h5py.Group, name: str, kind: str = "fc") -> np.ndarray:
