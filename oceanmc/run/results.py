@@ -74,14 +74,6 @@ class MergeError(ValueError):
     """Results that cannot be combined; the message says why."""
 
 
-def _scene_without(config_yaml: str, *keys: str) -> dict:
-    import yaml
-    scene = yaml.safe_load(config_yaml)
-    for key in keys:
-        scene.pop(key, None)
-    return scene
-
-
 def scene_difference(config_yaml: str, other_yaml: str, *ignored: str) -> str:
     """"" when the two stored scenes agree (but for the ignored top-level keys), else "KEY
     differs" naming the first key path where they do, so that a refusal says what to compare."""
@@ -105,7 +97,8 @@ def scene_difference(config_yaml: str, other_yaml: str, *ignored: str) -> str:
             return None
         return None if a == b else (path or "(top level)")
 
-    found = first(_scene_without(config_yaml), _scene_without(other_yaml), "")
+    import yaml
+    found = first(yaml.safe_load(config_yaml), yaml.safe_load(other_yaml), "")
     return f"{found} differs" if found else ""
 
 
