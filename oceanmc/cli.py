@@ -91,7 +91,8 @@ class StopRequest:
 def cmd_run(args: argparse.Namespace) -> int:
     from .config import ConfigError, config_to_yaml, data_file_hashes, load_config
     from .run.hdf5 import load_result
-    from .run.results import MergeError, check_same_data_files, format_summary, merge_results
+    from .run.results import (MergeError, check_same_data_files, format_summary,
+                              merge_results, scene_difference)
     from .run.compiling import CompileInterrupted
     from .run.simulation import simulate
     from . import scene
@@ -117,14 +118,15 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.resume and out.exists():
             try:
                 previous = load_result(out)
-            except (OSError, KeyError, ValueError) as exc:
-                raise UsageError(f"--resume: {out} is not a results file ({exc})") from None
+            except ValueError as exc:  # ResultsFileError: one line saying what is wrong
+                raise UsageError(f"--resume: {out}: {exc}") from None
             if not previous.attrs.get("partial", False):
                 raise UsageError(f"--resume: {out} is already complete "
                                  f"({previous.attrs['batches']} batches)")
-            if previous.config_yaml != config_to_yaml(config):
+            differs = scene_difference(previous.config_yaml, config_to_yaml(config))
+            if differs:
                 raise UsageError(f"--resume: {out} was made from a different scene than {path} "
-                                 "(compare with `oceanmc show --config`)")
+                                 f"({differs}; compare with `oceanmc show --config`)")
             try:
                 check_same_data_files(previous.attrs, {"data_files_sha256":
                                                        data_file_hashes(config)}, str(path))
@@ -199,8 +201,8 @@ def cmd_merge(args: argparse.Namespace) -> int:
             raise UsageError(f"{path}: no such file")
         try:
             parts.append(load_result(path))
-        except (OSError, KeyError, ValueError) as exc:
-            raise UsageError(f"{path}: not an oceanmc results file ({exc})") from None
+        except ValueError as exc:  # ResultsFileError: one line saying what is wrong
+            raise UsageError(f"{path}: {exc}") from None
     _check_writable(out, args.overwrite)
     try:
         merged = merge_results(parts)
@@ -221,8 +223,8 @@ def cmd_show(args: argparse.Namespace) -> int:
         raise UsageError(f"{path}: no such file")
     try:
         result = load_result(path)
-    except (OSError, KeyError, ValueError) as exc:
-        raise UsageError(f"{path}: not an oceanmc results file ({exc})") from None
+    except ValueError as exc:  # ResultsFileError: one line saying what is wrong
+        raise UsageError(f"{path}: {exc}") from None
     print(format_summary(result))
     if args.config:
         print(result.config_yaml)

@@ -155,7 +155,8 @@ def test_results_with_more_than_4100_layers_can_be_saved(tmp_path):
     names = [f"budget/absorbed_layer_{i + 1}" for i in range(4200)]
     quantities = {name: Quantity(name, (), np.full(2, 0.5), "1", "absorbed") for name in names}
     coords = {name: np.zeros(0) for name in COORD_UNITS if name != "batch"}
-    Result(coords, quantities, {"photons": 4}).save(tmp_path / "many.h5")
+    attrs = {"photons": 4, "batches": 2, "config_yaml": "name: many\n"}
+    Result(coords, quantities, attrs).save(tmp_path / "many.h5")
     back = load_result(tmp_path / "many.h5")
     assert len(back.quantities) == 4200
     assert back.quantities[names[-1]].batches.tolist() == [0.5, 0.5]

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import yaml
 
 from .results import Quantity, Result
 
@@ -141,26 +142,85 @@ def _write_iops(group: h5py.Group, iops: dict[str, np.ndarray]) -> None:
         ds.dims[1].attach_scale(group["wavelength"])
 
 
-def load_result(path: str | Path) -> Result:
-    """Reads a results file written by Result.save back into the same Result."""
-    path = Path(path)
-    with h5py.File(path, "r") as f:
-        attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
-        coords = {name: f[name][()] for name in COORD_UNITS if name != "batch" and name in f}
-        quantities = {}
+class ResultsFileError(ValueError):
+    """A file that is not a results file this version of oceanmc can read; the message says
+    what is wrong, in one line."""
 
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
-                if "dims" not in obj.attrs:
-                    return  # a coordinate of the batches group
-                quantities[name] = Quantity(name, dims_of(obj), obj[()],
-                                            _plain(obj.attrs["units"]),
-                                            _plain(f[name].attrs["description"]))
-        f["batches"].visititems(visit)
-        resume_state = None
-        if RESUME_GROUP in f:
-            resume_state = {name: f[RESUME_GROUP][name][()] for name in RESUME_FIELDS}
-        iops = {name: ds[()] for name, ds in f["iops"].items()} if "iops" in f else {}
+
+def load_result(path: str | Path) -> Result:
+    """Reads a results file written by Result.save back into the same Result. Raises
+    ResultsFileError (one line) for a file of another format version or one whose structure is
+    not what save_result writes (missing datasets or attributes, wrong shapes or types, links)."""
+    path = Path(path)
+    try:
+        with h5py.File(path, "r") as f:
+            version = _plain(f.attrs.get("format_version"))
+            if version != FORMAT_VERSION:
+                raise ResultsFileError(
+                    "no format_version attribute: not an oceanmc results file" if version is None
+                    else f"format_version {version!r}; this oceanmc reads format_version "
+                         f"{FORMAT_VERSION}")
+            return _read(f)
+    except ResultsFileError:
+        raise
+    except RecursionError:
+        raise ResultsFileError("nested too deeply to be a results file") from None
+    except (OSError, KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        # h5py reports a missing dataset, a dangling or external link, a truncated file as
+        # OSError/KeyError; a wrong dtype or shape surfaces as ValueError/TypeError below
+        detail = " ".join(str(exc).split()) or type(exc).__name__
+        raise ResultsFileError(f"not an oceanmc results file ({detail[:200]})") from None
+
+
+def _dataset(group: h5py.Group, name: str, kind: str = "fc") -> np.ndarray:
+    """group[name] as an array, refusing links to other files and non-numeric data."""
+    link = group.get(name, getlink=True)
+    if link is None:
+        raise KeyError(f"dataset {group.name.rstrip('/')}/{name} is missing")
+    if not isinstance(link, h5py.HardLink):
+        raise ValueError(f"{group.name.rstrip('/')}/{name} is a {type(link).__name__}, "
+                         "not a dataset")
+    obj = group[name]
+    if not isinstance(obj, h5py.Dataset) or obj.dtype.kind not in kind:
+        raise ValueError(f"{obj.name} is not a numeric dataset")
+    return obj[()]
+
+
+def _read(f: h5py.File) -> Result:
+    attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
+    for key in ("config_yaml", "batches"):
+        if key not in attrs:
+            raise KeyError(f"attribute {key} is missing")
+    try:  # merge and resume compare the stored scenes as mappings
+        scene = yaml.safe_load(attrs["config_yaml"]) if isinstance(attrs["config_yaml"], str) \
+            else None
+    except yaml.YAMLError:
+        scene = None
+    if not isinstance(scene, dict):
+        raise ValueError("attribute config_yaml does not hold a scene")
+    if not isinstance(attrs["batches"], int):
+        raise ValueError("attribute batches is not an integer")
+    # optional coordinates (wavelength: spectral files only) may be absent; a quantity whose
+    # dimension has no coordinate is refused by its reader below
+    coords = {name: _dataset(f, name, "fciu") for name in COORD_UNITS
+              if name != "batch" and name in f}
+    quantities = {}
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            if "dims" not in obj.attrs:
+                return  # a coordinate of the batches group
+            dims = dims_of(obj)
+            values = _dataset(obj.parent, obj.name.rsplit("/", 1)[1], "fciub")
+            if values.ndim != len(dims) + 1:  # batch first, then the named dimensions
+                raise ValueError(f"{obj.name} has {values.ndim} axes, not {len(dims) + 1}")
+            quantities[name] = Quantity(name, dims, values, str(_plain(obj.attrs["units"])),
+                                        str(_plain(f[name].attrs["description"])))
+    f["batches"].visititems(visit)
+    resume_state = None
+    if RESUME_GROUP in f:
+        resume_state = {name: _dataset(f[RESUME_GROUP], name, "fciu") for name in RESUME_FIELDS}
+    iops = {name: _dataset(f["iops"], name) for name in f["iops"]} if "iops" in f else {}
     return Result(coords, quantities, attrs, resume_state, iops)
 
 

@@ -10,6 +10,7 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -73,12 +74,32 @@ class MergeError(ValueError):
     """Results that cannot be combined; the message says why."""
 
 
-def _scene_without(config_yaml: str, *keys: str) -> dict:
+def scene_difference(config_yaml: str, other_yaml: str, *ignored: str) -> str:
+    """"" when the two stored scenes agree (but for the ignored top-level keys), else "KEY
+    differs" naming the first key path where they do, so that a refusal says what to compare."""
+    def first(a: Any, b: Any, path: str) -> str | None:
+        if isinstance(a, dict) and isinstance(b, dict):
+            for key in list(a) + [k for k in b if k not in a]:
+                if path == "" and key in ignored:
+                    continue
+                where = f"{path}.{key}" if path else str(key)
+                if key not in a or key not in b:
+                    return where
+                found = first(a[key], b[key], where)
+                if found:
+                    return found
+            return None
+        if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+            for i, (x, y) in enumerate(zip(a, b)):
+                found = first(x, y, f"{path}[{i}]")
+                if found:
+                    return found
+            return None
+        return None if a == b else (path or "(top level)")
+
     import yaml
-    scene = yaml.safe_load(config_yaml)
-    for key in keys:
-        scene.pop(key, None)
-    return scene
+    found = first(yaml.safe_load(config_yaml), yaml.safe_load(other_yaml), "")
+    return f"{found} differs" if found else ""
 
 
 def _batch_ranges(part: Result) -> list[tuple[int, int, int]]:
@@ -123,8 +144,10 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
     first = parts[0]
     if resume:
         for part in parts[1:]:
-            if part.config_yaml != first.config_yaml:
-                raise MergeError("the stored scene differs from the one being resumed")
+            differs = scene_difference(first.config_yaml, part.config_yaml)
+            if differs:
+                raise MergeError(f"the stored scene differs from the one being resumed "
+                                 f"({differs})")
             check_same_data_files(first.attrs, part.attrs, "the resumed part")
         expected = int(first.attrs.get("first_batch", 0))
         for i, part in enumerate(parts):
@@ -133,12 +156,13 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
                                  f", expected {expected}")
             expected += int(part.attrs["batches"])
     else:
-        scene = _scene_without(first.config_yaml, "seed", "photons", "name")
         ranges: list[tuple[int, int, int, int]] = []   # (seed, first, end, result number)
         for i, part in enumerate(parts):
-            if _scene_without(part.config_yaml, "seed", "photons", "name") != scene:
-                raise MergeError(f"result {i + 1} is a different scene (its water, surface, "
-                                 "bottom, illumination, tallies or estimator differ)")
+            differs = scene_difference(first.config_yaml, part.config_yaml,
+                                       "seed", "photons", "name")
+            if differs:
+                raise MergeError(f"result {i + 1} is a different scene from result 1 "
+                                 f"({differs})")
             check_same_data_files(first.attrs, part.attrs, f"result {i + 1}")
             if part.attrs.get("photons_per_batch") != first.attrs.get("photons_per_batch"):
                 raise MergeError(f"result {i + 1} has {part.attrs.get('photons_per_batch')} "

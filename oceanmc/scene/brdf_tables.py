@@ -41,7 +41,8 @@ from .. import registry
 from ..config import ConfigError
 from ..kernel import models
 from ..kernel.brdf import tables as ktables
-from .phase_tables import TableError, numeric_rows
+from .phase_tables import (ARRAY_FILE_ERRORS, TableError, hdf5_arrays, npz_arrays,
+                           numeric_rows)
 
 ENERGY_TOLERANCE = 1e-3
 ANALYTIC_RECIPROCITY = 1e-6
@@ -63,17 +64,13 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
     suffix = path.suffix.lower()
     if suffix == ".npz":
         try:
-            with np.load(path, allow_pickle=False) as data:
-                return {k: np.asarray(data[k]) for k in data.files}
-        except (OSError, ValueError, EOFError) as exc:
+            return npz_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as .npz ({exc})")
     if suffix in (".h5", ".hdf5", ".he5"):
-        import h5py
         try:
-            with h5py.File(path, "r") as h5:
-                return {k: np.asarray(h5[k][()]) for k in h5.keys()
-                        if isinstance(h5[k], h5py.Dataset)}
-        except (OSError, ValueError, TypeError) as exc:
+            return hdf5_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as HDF5 ({exc})")
     if suffix in (".csv", ".txt", ".dat"):
         return _text_table(path)

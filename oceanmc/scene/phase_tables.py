@@ -9,6 +9,7 @@ interval). The table is renormalised to a total probability of 1.
 from __future__ import annotations
 
 import math
+import zipfile
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -123,6 +124,56 @@ def fournier_forand_table(bb_ratio: float) -> tuple[np.ndarray, np.ndarray, np.n
 
 
 # --- user tables ------------------------------------------------------------------------------
+
+
+MAX_TABLE_VALUES = 10**8   # 800 MB of float64: far beyond any table, refused before loading
+# what a malformed array file raises in the readers below; callers turn it into a TableError
+ARRAY_FILE_ERRORS = (OSError, ValueError, EOFError, TypeError, KeyError, zipfile.BadZipFile,
+                     NotImplementedError)
+
+
+def bounded_npy(file, name: str) -> np.ndarray:
+    """The array of an .npy stream, its header's shape checked against MAX_TABLE_VALUES first
+    (a header may claim 10^10 values in a file of a few bytes)."""
+    readers = {(1, 0): np.lib.format.read_array_header_1_0,
+               (2, 0): np.lib.format.read_array_header_2_0}
+    version = np.lib.format.read_magic(file)
+    if version not in readers:
+        raise ValueError(f"{name}: .npy format version {version} not supported")
+    shape, _, _ = readers[version](file)
+    if math.prod(shape) > MAX_TABLE_VALUES:
+        raise ValueError(f"{name}: its header claims shape {shape}, more than "
+                         f"{MAX_TABLE_VALUES:,} values")
+    file.seek(0)
+    return np.lib.format.read_array(file, allow_pickle=False)
+
+
+def npz_arrays(path: Path) -> dict[str, np.ndarray]:
+    """The arrays of an .npz archive, each bounded as in bounded_npy."""
+    data = {}
+    with zipfile.ZipFile(path) as archive:
+        for member in archive.namelist():
+            with archive.open(member) as file:
+                data[member.removesuffix(".npy")] = bounded_npy(file, member)
+    return data
+
+
+def hdf5_arrays(path: Path) -> dict[str, np.ndarray]:
+    """The top-level datasets of an HDF5 file; soft and external links are not followed (they
+    may dangle or leave the file), sizes are bounded as in bounded_npy."""
+    import h5py
+    data = {}
+    with h5py.File(path, "r") as h5:
+        for k in h5.keys():
+            if not isinstance(h5.get(k, getlink=True), h5py.HardLink) or \
+                    not isinstance(h5[k], h5py.Dataset):
+                continue
+            if h5[k].size > MAX_TABLE_VALUES:
+                raise ValueError(f"{k} holds {h5[k].size:,} values, more than "
+                                 f"{MAX_TABLE_VALUES:,}")
+            data[k] = np.asarray(h5[k][()])
+    return data
+
 
 def numeric_rows(path: Path, what: str) -> list[tuple[int, list[float]]]:
     """(line number, values) of each data line of a text table: comma or whitespace separated,

@@ -71,7 +71,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .phase_tables import TableError
+from .phase_tables import (ARRAY_FILE_ERRORS, TableError, bounded_npy, hdf5_arrays,
+                           npz_arrays)
 
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
 HC_GAUSS = 8              # Gauss points per cell side for its cell averages
@@ -231,22 +232,19 @@ def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
     data: dict[str, np.ndarray] = {}
     if suffix == ".npy":
         try:
-            data[dataset] = np.load(path, allow_pickle=False)
-        except (OSError, ValueError, EOFError) as exc:
+            with open(path, "rb") as file:
+                data[dataset] = bounded_npy(file, dataset)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as .npy ({exc})")
     elif suffix == ".npz":
         try:
-            with np.load(path, allow_pickle=False) as z:
-                data = {k: np.asarray(z[k]) for k in z.files}
-        except (OSError, ValueError, EOFError) as exc:
+            data = npz_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as .npz ({exc})")
     elif suffix in (".h5", ".hdf5", ".he5"):
-        import h5py
         try:
-            with h5py.File(path, "r") as h5:
-                data = {k: np.asarray(h5[k][()]) for k in h5.keys()
-                        if isinstance(h5[k], h5py.Dataset)}
-        except (OSError, ValueError, TypeError) as exc:
+            data = hdf5_arrays(path)
+        except ARRAY_FILE_ERRORS as exc:
             _fail(path, f"cannot read it as HDF5 ({exc})")
     elif suffix == ".exr":
         data[dataset] = _read_exr(path, dataset, layout)
