@@ -200,8 +200,7 @@ def _read(f: h5py.File) -> Result:
         raise ValueError("attribute config_yaml does not hold a scene")
     if not isinstance(attrs["batches"], int):
         raise ValueError("attribute batches is not an integer")
-    # optional coordinates (wavelength: spectral files only) may be absent; a quantity whose
-    # dimension has no coordinate is refused by its reader below
+    # some coordinates are optional (wavelength: spectral files only)
     coords = {name: _dataset(f, name, "fciu") for name in COORD_UNITS
               if name != "batch" and name in f}
     quantities = {}
