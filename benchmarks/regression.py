@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections import Counter
 import sys
 import time
 from pathlib import Path
@@ -37,6 +38,7 @@ from scipy import stats
 ROOT = Path(__file__).resolve().parent.parent
 FAMILY_ALPHA = 0.01
 EXACT_MIN_BATCHES = 8
+ROUNDING = 1e-12            # relative difference below which two values are equal to rounding
 
 
 def _store(store: dict, key: str, result) -> None:
@@ -96,7 +98,7 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
     missing = sorted(set(keys) - set(keys_after))
     extra = sorted(set(keys_after) - set(keys))
     rows = []
-    n_elements = n_identical = n_exact = n_untested = 0
+    n_elements = n_identical = n_exact = n_untested = n_rounding = 0
     for key in keys:
         if key in missing:
             continue
@@ -113,17 +115,21 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         exact = finite & (se == 0.0)
         n_exact += int(exact.sum())
         scale = np.maximum(np.abs(m0), np.abs(m1))
-        exact_bad = exact & (np.abs(m1 - m0) > 1e-12 * np.maximum(scale, 1e-300))
+        # equal to rounding: a deterministic quantity (the incoming sun in its quad) has a
+        # standard error of rounding noise (1e-15), so a z of such differences means nothing
+        rounding = finite & (np.abs(m1 - m0) <= ROUNDING * np.maximum(scale, 1e-300))
+        n_rounding += int((rounding & (m0 != m1)).sum())
+        exact_bad = exact & ~rounding
         n1 = batches(after, key)
         n0 = batches(before, key) or n1
         if 0 < min(n0, n1) < EXACT_MIN_BATCHES:
             n_untested += int(exact_bad.sum())
             exact_bad = np.zeros_like(exact_bad)
         with np.errstate(divide="ignore", invalid="ignore"):
-            z = np.where(finite & (se > 0.0), (m1 - m0) / se, 0.0)
+            tested = finite & (se > 0.0) & ~rounding
+            z = np.where(tested, (m1 - m0) / se, 0.0)
             if min(n0, n1) >= 2:
                 nu = (v0 + v1) ** 2 / (v0 ** 2 / (n0 - 1) + v1 ** 2 / (n1 - 1))
-                tested = finite & (se > 0.0)
                 z[tested] = np.sign(z[tested]) * stats.norm.isf(
                     stats.t.sf(np.abs(z[tested]), nu[tested]))
         worst = float(np.max(np.abs(z))) if z.size else 0.0
@@ -148,7 +154,8 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         f" missing after: {len(missing)}, new after: {len(extra)})",
         f"- elements compared: {n_elements}; bit-identical: {n_identical}; exact (zero standard "
         f"error on both sides): {n_exact}; of those, untested (equal batches by chance in a "
-        f"scene of fewer than {EXACT_MIN_BATCHES} batches, values differ): {n_untested}",
+        f"scene of fewer than {EXACT_MIN_BATCHES} batches, values differ): {n_untested}; "
+        f"equal to rounding (relative difference <= {ROUNDING:g}, not z-tested): {n_rounding}",
         f"- bound: |z| <= {bound:.2f} (Bonferroni, family-wise two-sided alpha {FAMILY_ALPHA} "
         f"over {n_elements} elements)",
         f"- worst |z|: {worst:.3g}; failing quantities: {len(failing)}",
@@ -157,7 +164,10 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
     if missing:
         lines += ["Missing after: " + ", ".join(missing), ""]
     if extra:
-        lines += ["New after (not compared): " + ", ".join(extra), ""]
+        # by quantity name, with the number of scenes that have it
+        by_name = Counter(key.split("|", 1)[1] for key in extra)
+        lines += ["New after (not compared; quantity: scenes): " + ", ".join(
+            f"{name}: {count}" for name, count in sorted(by_name.items())), ""]
     if failing:
         lines += ["| quantity | elements | worst abs z | note |", "|---|---|---|---|"]
         lines += [f"| {k} | {n} | {w:.3g} | {note} |" for k, n, w, note in failing]
@@ -170,7 +180,7 @@ def compare(before_path: Path, after_path: Path, report: Path | None,
         report.write_text(text)
         report.with_suffix(".json").write_text(json.dumps(
             {"elements": n_elements, "identical": n_identical, "exact": n_exact,
-             "untested": n_untested,
+             "untested": n_untested, "rounding": n_rounding,
              "bound": bound, "worst_z": worst, "missing": missing, "extra": extra,
              "rows": [{"quantity": k, "elements": n, "worst_z": w, "note": note}
                       for k, n, w, note in rows]}, indent=1, default=float))
