@@ -29,7 +29,7 @@ def _draw(sc, layer, u_pick, u):
     medium, mf, mi = sc
     out = np.empty(u.shape[0])
     for i in range(u.shape[0]):
-        out[i] = dispatch.sample_cos(medium[0], mf, mi, layer, u_pick[i], u[i])
+        out[i] = dispatch.sample_cos(medium[0], mf, mi, layer, 0, u_pick[i], u[i])
     return out
 
 

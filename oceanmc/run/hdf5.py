@@ -200,9 +200,9 @@ def _read(f: h5py.File) -> Result:
         raise ValueError("attribute config_yaml does not hold a scene")
     if not isinstance(attrs["batches"], int):
         raise ValueError("attribute batches is not an integer")
-    # some coordinates are optional (wavelength: spectral files only)
+    # the wavelength coordinate is in spectral files only; every other one is required
     coords = {name: _dataset(f, name, "fciu") for name in COORD_UNITS
-              if name != "batch" and name in f}
+              if name != "batch" and (name != "wavelength" or name in f)}
     quantities = {}
 
     def visit(name, obj):
