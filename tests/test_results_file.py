@@ -59,6 +59,26 @@ def test_xarray_sees_named_dimensions(saved):
     air.close()
 
 
+def test_direction_angles_are_coordinates_in_every_group(small_scene, tmp_path):
+    small_scene["tallies"]["local_directions_deg"] = [[180, 0], [150, 30]]
+    saved = oceanmc.simulate(small_scene).save(tmp_path / "local.h5")
+    for group, variable in ((None, "local_radiance"), ("air", "Lw_local"),
+                            ("batches/air", "Rrs_local")):
+        with xr.open_dataset(saved, engine="h5netcdf", group=group) as ds:
+            for angle, values in (("direction_theta", [180, 150]), ("direction_phi", [0, 30])):
+                assert angle in ds.coords and angle not in ds.data_vars, (group, angle)
+                assert ds[variable].coords[angle].values.tolist() == values
+                assert ds[angle].dims == ("direction",)
+    with xr.open_dataset(saved, engine="h5netcdf", group="air") as air:
+        assert air["Lw_local"].sel(direction=1).direction_theta == 150.0
+
+
+def test_direction_angles_are_coordinates_without_local_directions(saved):
+    with xr.open_dataset(saved, engine="h5netcdf") as ds:
+        assert {"direction_theta", "direction_phi"} <= set(ds.coords)
+        assert not {"direction_theta", "direction_phi"} & set(ds.data_vars)
+
+
 def test_load_result_gives_back_the_same_result(result, saved):
     back = oceanmc.load_result(saved)
     assert set(back.quantities) == set(result.quantities)

@@ -84,7 +84,17 @@ def _write(f: h5py.File, result: Result) -> None:
             ds.make_scale(dim)
             ds.attrs["units"], ds.attrs["description"] = COORD_UNITS[dim]
             scales[group, dim] = ds
+            auxiliary = auxiliary_of((dim,))
+            if auxiliary:
+                # named here too, so that xarray makes them coordinates even in a group where
+                # no variable uses the dimension (no local directions)
+                ds.attrs["coordinates"] = " ".join(auxiliary)
+            for aux in auxiliary if group else ():  # the root's come with the other coordinates
+                write(f"{group}/{aux}", coords[aux], (dim,), *COORD_UNITS[aux])
         return scales[group, dim]
+
+    def auxiliary_of(dims: tuple[str, ...]) -> list[str]:
+        return [aux for aux, dim in AUXILIARY_COORDS.items() if dim in dims]
 
     def write(name: str, values: np.ndarray, dims: tuple[str, ...], units: str, desc: str,
               **options) -> h5py.Dataset:
@@ -94,6 +104,9 @@ def _write(f: h5py.File, result: Result) -> None:
         group = name.rpartition("/")[0]
         for axis, dim in enumerate(dims):
             ds.dims[axis].attach_scale(scale(group, dim))
+        # CF auxiliary coordinates (direction_theta of `direction`): xarray's coordinates
+        if auxiliary_of(dims) and name.rpartition("/")[2] not in AUXILIARY_COORDS:
+            ds.attrs["coordinates"] = " ".join(auxiliary_of(dims))
         return ds
 
     for name, values in result.coords.items():
