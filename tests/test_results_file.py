@@ -6,6 +6,8 @@ import xarray as xr
 
 import oceanmc
 from oceanmc.run.hdf5 import save_result
+from oceanmc.cli import main
+from oceanmc.run.results import format_summary
 
 
 @pytest.fixture(scope="module")
@@ -77,6 +79,19 @@ def test_direction_angles_are_coordinates_without_local_directions(saved):
     with xr.open_dataset(saved, engine="h5netcdf") as ds:
         assert {"direction_theta", "direction_phi"} <= set(ds.coords)
         assert not {"direction_theta", "direction_phi"} & set(ds.data_vars)
+
+
+def test_show_lists_the_summary_in_the_order_run_does(small_scene, tmp_path, capsys):
+    small_scene["water"]["layers"] *= 11   # absorbed_layer_10 sorts before _2 by name
+    small_scene["photons"] = 2000
+    result = oceanmc.simulate(small_scene)
+    assert main(["show", str(result.save(tmp_path / "r.h5"))]) == 0
+    shown = [line.split()[:2] for line in capsys.readouterr().out.splitlines()[2:]]
+    ran = [line.split()[:2] for line in format_summary(result).splitlines()[2:]]
+    assert shown == ran
+    budget = [words[1] for words in ran if words[0] == "budget"]
+    assert budget[:3] == ["surface_reflection", "water_leaving", "absorbed_layer_1"]
+    assert budget[13:] == ["absorbed_bottom", "lost_below", "truncated", "total"]
 
 
 def test_load_result_gives_back_the_same_result(result, saved):

@@ -418,9 +418,13 @@ def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
         row(f"Eu({where})", "Eu", "W/m2", i)
         row(f"Eo({where})", "Eo", "W/m2", i)
         row(f"Lu({where})", "Lu", "W/m2/sr", i)
-    for name in result.quantities:
-        if name.startswith("budget/"):
-            row("budget " + name.split("/", 1)[1], name, "1")
+    # the budget in the order of budget_terms, as a run makes it (a file read back lists its
+    # datasets alphabetically): one order for `run` and `show`
+    budget = [name for name in result.quantities if name.startswith("budget/")]
+    n_layers = sum(name.startswith("budget/absorbed_layer_") for name in budget)
+    order = [f"budget/{term}" for _, term, _ in budget_terms(n_layers)] + ["budget/total"]
+    for name in order + [name for name in budget if name not in order]:
+        row("budget " + name.split("/", 1)[1], name, "1")
     return rows
 
 
