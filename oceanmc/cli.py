@@ -94,7 +94,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .run.results import (MergeError, check_same_data_files, format_summary,
                               merge_results, scene_difference)
     from .run.compiling import CompileInterrupted
-    from .run.simulation import simulate
+    from .run.simulation import check_tally_memory, simulate
     from . import scene
 
     configs = [Path(c) for c in args.configs]
@@ -107,7 +107,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     for path, out in zip(configs, outputs):
         try:
             config = load_config(path, overrides)
-            scene.build(config)  # reads its data files: every scene is checked before any runs
+            # reads its data files: every scene is checked before any runs
+            check_tally_memory(config, scene.build(config))
         except ConfigError as exc:
             print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
                   else f"oceanmc: config error: {exc}", file=sys.stderr)

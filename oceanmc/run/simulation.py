@@ -11,6 +11,7 @@ resumed run continues them exactly."""
 from __future__ import annotations
 
 import math
+import os
 import sys
 import threading
 import time
@@ -24,7 +25,7 @@ from tqdm import tqdm
 
 from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
-from ..config import SceneConfig, config_to_yaml, data_file_hashes, load_config
+from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
@@ -42,6 +43,36 @@ MIN_BUDGET = 1 << 8
 POLL_SECONDS = 0.25     # how often the main thread looks at stops, checkpoints and progress
 ESTIMATE_AFTER_S = 3.0  # tracing time before a run's duration is estimated
 LONG_RUN_S = 3600.0     # a run estimated longer than this says so at its start
+
+
+# the tallies may take this share of the machine's physical memory, counting the RESULT_COPIES
+# of them a run holds at its end (the rows, their normalised copy in from_tallies, the
+# temporaries of the means and standard errors written to the file)
+MEMORY_SHARE = 0.5
+RESULT_COPIES = 3
+
+
+def row_floats(tally_size: int) -> int:
+    """Floats of one batch's tally row: whole cache lines and one more, so that no two batches
+    share a line (false sharing; measured: 1.5x instead of 2x on 2 threads)."""
+    return -(-tally_size // LINE_FLOATS) * LINE_FLOATS + LINE_FLOATS
+
+
+def check_tally_memory(config: SceneConfig, sc: scene.Scene) -> None:
+    """Raises ConfigError (one line: the estimate and the limit) before anything is allocated
+    when the scene's tallies would not fit in memory."""
+    try:
+        physical = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # no such query here: nothing to compare to
+        return
+    need = RESULT_COPIES * 8 * config.batches * row_floats(sc.tally_size)
+    if physical > 0 and need > MEMORY_SHARE * physical:
+        raise ConfigError(
+            f"tallies: {config.batches} batches x {sc.tally_size:,} tally values need about "
+            f"{need / 2**30:,.1f} GiB, more than the limit of {MEMORY_SHARE * physical / 2**30:.1f}"
+            f" GiB ({MEMORY_SHARE:.0%} of this machine's memory); use fewer tallies.depths_m, "
+            "wider bands (tallies.theta_edges_deg, tallies.phi_bands), tallies.radiance: false "
+            "or fewer batches")
 
 
 def next_budget(budget: int, seconds: float) -> int:
@@ -93,6 +124,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     startup = time.perf_counter() - t0
     data_hashes = data_file_hashes(config)   # before the build reads them
     sc = scene.build(config)
+    check_tally_memory(config, sc)
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
     n_batches = config.batches - first_batch
@@ -108,9 +140,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     beams = np.zeros((n_batches, 4))
     beams[:, 3] = 1.0
     next_photon = np.full(n_batches, -1, dtype=np.int64)
-    # each batch's tally row and packet on cache lines of their own: two threads writing to
-    # one line slow each other down (false sharing; measured: 1.5x instead of 2x on 2 threads)
-    tallies = np.zeros((n_batches, -(-sc.tally_size // LINE_FLOATS) * LINE_FLOATS + LINE_FLOATS))
+    # each batch's tally row and packet on cache lines of their own
+    tallies = np.zeros((n_batches, row_floats(sc.tally_size)))
     events = np.zeros(n_batches, dtype=np.int64)
     if resume_state is not None:
         _restore(resume_state, first_batch, n_batches, sc.tally_size, rngs, beams, next_photon,
