@@ -91,8 +91,8 @@ class StopRequest:
 def cmd_run(args: argparse.Namespace) -> int:
     from .config import ConfigError, config_to_yaml, data_file_hashes, load_config
     from .run.hdf5 import load_result
-    from .run.results import (MergeError, check_same_data_files, format_summary,
-                              merge_results, scene_difference)
+    from .run.results import (MergeError, check_resumable, check_same_data_files,
+                              format_summary, merge_results, scene_difference)
     from .run.compiling import CompileInterrupted
     from .run.simulation import check_tally_memory, simulate
     from . import scene
@@ -124,6 +124,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             if not previous.attrs.get("partial", False):
                 raise UsageError(f"--resume: {out} is already complete "
                                  f"({previous.attrs['batches']} batches)")
+            try:
+                check_resumable(previous)
+            except MergeError as exc:
+                raise UsageError(f"--resume: {out}: {exc}") from None
             differs = scene_difference(previous.config_yaml, config_to_yaml(config))
             if differs:
                 raise UsageError(f"--resume: {out} was made from a different scene than {path} "

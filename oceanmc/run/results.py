@@ -130,6 +130,15 @@ def check_same_data_files(stored: dict, current: dict, what: str) -> None:
                              "would mix two different scenes")
 
 
+def check_resumable(part: Result) -> None:
+    """Raises MergeError when part holds several runs (a merge): their unfinished batches are
+    not kept and their batch ranges are not one run's, so it cannot be continued."""
+    if "merged_from" in part.attrs or "seeds" in part.attrs:
+        raise MergeError(f"it merges {part.attrs.get('merged_from', 'several')} runs (seeds "
+                         f"{part.attrs.get('seeds')}) and cannot be continued: resume each "
+                         "partial run in its own file, then merge them")
+
+
 def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
     """One Result from several runs of the same scene, by concatenating their batches (the
     standard errors then come from all batches together).
@@ -143,6 +152,7 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
         raise MergeError("need at least two results to merge")
     first = parts[0]
     if resume:
+        check_resumable(first)
         for part in parts[1:]:
             differs = scene_difference(first.config_yaml, part.config_yaml)
             if differs:
