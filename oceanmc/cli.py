@@ -38,6 +38,8 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
 
 def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0) -> None:
     """Fails before any photon is traced if the results file cannot be written."""
+    if "\0" in str(path):   # no file system takes one; Path.exists() just says False
+        raise UsageError(f"{str(path)!r}: a file name cannot hold a NUL byte")
     if path.exists() and path.is_dir():
         raise UsageError(f"{path} is a folder, not a results file")
     if path.exists() and not overwrite:
@@ -128,6 +130,10 @@ def cmd_run(args: argparse.Namespace) -> int:
                 check_resumable(previous)
             except MergeError as exc:
                 raise UsageError(f"--resume: {out}: {exc}") from None
+            done = int(previous.attrs["first_batch"]) + int(previous.attrs["batches"])
+            if done >= config.batches:
+                raise UsageError(f"--resume: {out} is marked partial but holds batches up to "
+                                 f"{done - 1} of {path}'s {config.batches}: nothing to continue")
             differs = scene_difference(previous.config_yaml, config_to_yaml(config))
             if differs:
                 raise UsageError(f"--resume: {out} was made from a different scene than {path} "
@@ -336,8 +342,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return bench.main(Path(args.output), configs, bare_walk, quick=args.quick)
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """Bad options in one line (exit 2), pointing at --help rather than printing the usage."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="oceanmc",
         description="Monte Carlo radiative transfer for natural waters: layered water, flat "
                     "Fresnel surface, BRDF bottom, sun and sky.")

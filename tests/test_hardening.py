@@ -155,7 +155,9 @@ def test_results_with_more_than_4100_layers_can_be_saved(tmp_path):
     names = [f"budget/absorbed_layer_{i + 1}" for i in range(4200)]
     quantities = {name: Quantity(name, (), np.full(2, 0.5), "1", "absorbed") for name in names}
     coords = {name: np.zeros(0) for name in COORD_UNITS if name != "batch"}
-    attrs = {"photons": 4, "batches": 2, "config_yaml": "name: many\n"}
+    attrs = {"photons": 4, "batches": 2, "config_yaml": "name: many\n", "threads": 1,
+             "seed": 1, "first_batch": 0, "photons_per_batch": 2, "scattering_events": 0,
+             "wall_time_s": 1.0, "startup_time_s": 0.0, "photons_per_s": 4.0}
     Result(coords, quantities, attrs).save(tmp_path / "many.h5")
     back = load_result(tmp_path / "many.h5")
     assert len(back.quantities) == 4200

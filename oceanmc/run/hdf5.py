@@ -4,6 +4,7 @@ names every dimension; and read back."""
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -204,6 +205,7 @@ def _read(f: h5py.File) -> Result:
     for key in ("config_yaml", "batches"):
         if key not in attrs:
             raise KeyError(f"attribute {key} is missing")
+    _check_attrs(attrs)
     try:  # merge and resume compare the stored scenes as mappings
         scene = yaml.safe_load(attrs["config_yaml"]) if isinstance(attrs["config_yaml"], str) \
             else None
@@ -211,8 +213,6 @@ def _read(f: h5py.File) -> Result:
         scene = None
     if not isinstance(scene, dict):
         raise ValueError("attribute config_yaml does not hold a scene")
-    if not isinstance(attrs["batches"], int):
-        raise ValueError("attribute batches is not an integer")
     # the wavelength coordinate is in spectral files only; every other one is required
     coords = {name: _dataset(f, name, "fciu") for name in COORD_UNITS
               if name != "batch" and (name != "wavelength" or name in f)}
@@ -234,6 +234,36 @@ def _read(f: h5py.File) -> Result:
         resume_state = {name: _dataset(f[RESUME_GROUP], name, "fciu") for name in RESUME_FIELDS}
     iops = {name: _dataset(f["iops"], name) for name in f["iops"]} if "iops" in f else {}
     return Result(coords, quantities, attrs, resume_state, iops)
+
+
+# the attributes the summary, merge and --resume read, and what each must be where present
+COUNT_ATTRS = ("batches", "photons", "threads", "seed", "first_batch", "photons_per_batch",
+               "scattering_events", "merged_from")
+SECONDS_ATTRS = ("wall_time_s", "startup_time_s", "photons_per_s")
+LIST_ATTRS = {"seeds": re.compile(r"\d+(,\d+)*"),
+              "batch_ranges": re.compile(r"\d+:\d+:\d+(,\d+:\d+:\d+)*")}
+
+
+def _check_attrs(attrs: dict) -> None:
+    for key in COUNT_ATTRS + SECONDS_ATTRS:
+        if key not in attrs and key != "merged_from":   # merged_from: merged files only
+            raise KeyError(f"attribute {key} is missing")
+    for key in COUNT_ATTRS:
+        value = attrs.get(key, 0)
+        if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value < 2**62:
+            raise ValueError(f"attribute {key} is not a count (an integer >= 0)")
+    for key in SECONDS_ATTRS:
+        value = attrs.get(key, 0.0)
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or not value >= 0:
+            raise ValueError(f"attribute {key} is not a number >= 0")
+    for key, pattern in LIST_ATTRS.items():
+        if key in attrs and not (isinstance(attrs[key], str) and pattern.fullmatch(attrs[key])):
+            raise ValueError(f"attribute {key} is not a list like {pattern.pattern}")
+    if not isinstance(attrs.get("partial", False), (bool, int)):
+        raise ValueError("attribute partial is not a boolean")
+    for key in ("name", "data_files_sha256"):
+        if not isinstance(attrs.get(key, ""), str):
+            raise ValueError(f"attribute {key} is not text")
 
 
 def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:

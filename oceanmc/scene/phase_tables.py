@@ -9,7 +9,9 @@ interval). The table is renormalised to a total probability of 1.
 from __future__ import annotations
 
 import math
+import tokenize
 import zipfile
+import zlib
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -128,8 +130,11 @@ def fournier_forand_table(bb_ratio: float) -> tuple[np.ndarray, np.ndarray, np.n
 
 MAX_TABLE_VALUES = 10**8   # 800 MB of float64: far beyond any table, refused before loading
 # what a malformed array file raises in the readers below; callers turn it into a TableError
+# (numpy parses an .npy header with ast.literal_eval: a mangled one raises SyntaxError or
+# tokenize.TokenError; a mangled deflated member zlib.error)
 ARRAY_FILE_ERRORS = (OSError, ValueError, EOFError, TypeError, KeyError, zipfile.BadZipFile,
-                     NotImplementedError)
+                     NotImplementedError, SyntaxError, tokenize.TokenError, RecursionError,
+                     zlib.error)
 
 
 def bounded_npy(file, name: str) -> np.ndarray:
