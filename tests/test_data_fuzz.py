@@ -9,7 +9,7 @@ import h5py
 import numpy as np
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import oceanmc
@@ -125,6 +125,8 @@ def _with_attribute(path, name, value):
 @settings(max_examples=60, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(st.sampled_from(ATTRS), ATTR_VALUES, st.sampled_from(["show", "merge", "resume"]))
+@example("name", b"\x80", "show").via("found by a longer run")
+@example("partial", True, "resume").via("found by a longer run")
 def test_results_files_with_mutated_attributes(results_file, tmp_path, capsys, name, value,
                                                command):
     path = tmp_path / "mutated.h5"
@@ -177,6 +179,7 @@ class WouldRun(Exception):
 @given(st.lists(st.tuples(st.sampled_from(["--photons", "--seed", "--threads",
                                            "--checkpoint-every"]), FLAG_TEXT), max_size=4),
        OUT_NAMES)
+@example([], "a\0b").via("found by a longer run")
 def test_random_flags_run_or_fail_in_one_line(tmp_path, monkeypatch, capsys, flags, out):
     """Every flag and -o value either passes every check made before the first photon (the
     run would start) or is refused with exit 2 in one line."""

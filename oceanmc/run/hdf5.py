@@ -264,6 +264,8 @@ def _check_attrs(attrs: dict) -> None:
     for key in ("name", "data_files_sha256"):
         if not isinstance(attrs.get(key, ""), str):
             raise ValueError(f"attribute {key} is not text")
+    if not attrs.get("name", "").isprintable():   # show prints it: no escapes, no surrogates
+        raise ValueError("attribute name holds unprintable characters")
 
 
 def dims_of(dataset: h5py.Dataset) -> tuple[str, ...]:
