@@ -251,7 +251,7 @@ def _check_attrs(attrs: dict) -> None:
     for key in COUNT_ATTRS:
         value = attrs.get(key, 0)
         if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value < 2**62:
-            raise ValueError(f"attribute {key} is not a count (an integer >= 0)")
+            raise ValueError(f"attribute {key} is not an integer >= 0")
     for key in SECONDS_ATTRS:
         value = attrs.get(key, 0.0)
         if not isinstance(value, (int, float)) or isinstance(value, bool) or not value >= 0:
