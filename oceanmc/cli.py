@@ -156,8 +156,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         def combined(result, previous=previous):
             return result if previous is None else merge_results([previous, result], resume=True)
 
-        def checkpoint(partial, out=out, combined=combined):
-            combined(partial).save(out)
+        # the first placement refuses to replace a file another run made meanwhile; the
+        # checkpoints that follow replace this run's own file
+        replace = {"ok": args.overwrite or previous is not None}
+
+        def checkpoint(partial, out=out, combined=combined, replace=replace):
+            combined(partial).save(out, overwrite=replace["ok"])
+            replace["ok"] = True
         try:
             result = simulate(config, threads=args.threads, progress=not args.quiet,
                               first_batch=first, should_stop=lambda: stop.requested,
@@ -176,7 +181,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             sys.stdout.flush()
             os._exit(130)
         result.attrs["config_file"] = str(path)
-        result.save(out)
+        result.save(out, overwrite=replace["ok"])
         print(format_summary(result))
         print(f"  wrote {out}")
         if result.attrs.get("partial"):
@@ -219,7 +224,7 @@ def cmd_merge(args: argparse.Namespace) -> int:
         merged = merge_results(parts)
     except MergeError as exc:
         raise UsageError(f"cannot merge: {exc}") from None
-    merged.save(out)
+    merged.save(out, overwrite=args.overwrite)
     print(format_summary(merged))
     print(f"  merged {len(parts)} runs (seeds {merged.attrs['seeds']}) into {out}")
     return 0
@@ -475,6 +480,11 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as exc:
         print(f"oceanmc: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if not hasattr(exc, "kept"):  # run.hdf5.ResultsSavedElsewhere, without importing h5py
+            raise
+        print(f"oceanmc: error: {exc}", file=sys.stderr)
+        return 1 if "no space" in exc.reason else 2
     except KeyboardInterrupt:
         print("oceanmc: interrupted; no partial results file was written", file=sys.stderr)
         return 130

@@ -63,9 +63,10 @@ class Result:
     def config_yaml(self) -> str:
         return str(self.attrs["config_yaml"])
 
-    def save(self, path: str | Path) -> Path:
+    def save(self, path: str | Path, overwrite: bool = True) -> Path:
+        """overwrite=False: never replace an existing file (hdf5.place_atomically)."""
         from .hdf5 import save_result
-        return save_result(self, path)
+        return save_result(self, path, overwrite)
 
 
 # --- merging ------------------------------------------------------------------------------------

@@ -9,8 +9,6 @@ every quantity X of the results file (`air/Rrs_nadir` becomes `air_Rrs_nadir`, `
 `photons` and `wall_time_s`; the base scene and the sweep in the attributes."""
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,7 +16,7 @@ import numpy as np
 import yaml
 
 from .. import __version__
-from ..run.hdf5 import COORD_UNITS, load_result
+from ..run.hdf5 import COORD_UNITS, load_result, place_atomically
 from ..run.results import Result, merge_results
 from .axes import SweepSpec, coordinate
 from .points import Point
@@ -177,18 +175,4 @@ def _coord_attrs(name: str) -> dict:
 def write_dataset(dataset, path: Path) -> Path:
     """NetCDF4 via h5netcdf, atomically (a temporary file renamed into place), so a crash or a
     second Ctrl-C never leaves half a dataset."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    os.close(fd)
-    try:
-        dataset.to_netcdf(tmp, engine="h5netcdf")
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return place_atomically(path, lambda tmp: dataset.to_netcdf(tmp, engine="h5netcdf"))
