@@ -87,3 +87,17 @@ def test_disk_full_keeps_results_in_temp_dir(tmp_path, monkeypatch):
     assert info.value.kept.parent == spare
     assert np.load(open(info.value.kept, "rb"))[0] == 5.0
     assert "no space" in str(info.value)
+
+
+def test_phase_table_scaled_by_1e300_same_as_unscaled(tmp_path):
+    from oceanmc.scene.phase_tables import user_table
+    angle = np.linspace(0.0, 180.0, 19)
+    p = np.exp(-angle / 30.0)
+    for name, scale in (("a.csv", 1.0), ("b.csv", 1e300), ("c.csv", 1e308 / p.max())):
+        np.savetxt(tmp_path / name, np.column_stack([angle, p * scale]), delimiter=",")
+    ref = user_table(tmp_path / "a.csv")
+    for name in ("b.csv", "c.csv"):
+        got = user_table(tmp_path / name)
+        for r, g in zip(ref, got):
+            assert np.all(np.isfinite(g))
+            np.testing.assert_allclose(g, r, rtol=1e-12)

@@ -239,7 +239,10 @@ def user_table(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     2 pi p sin psi is piecewise linear, as for Petzold; missing ends at 0 and 180 deg get q = 0."""
     angle, p = read_angle_table(path)
     psi = np.radians(angle)
-    q = 2.0 * math.pi * p * np.sin(psi)
+    peak = float(np.max(p))
+    # the scale of p is normalised away; dividing by its peak first keeps a table of values
+    # near 1e308 from overflowing to inf in 2 pi p sin psi and in the integral
+    q = 2.0 * math.pi * (p / peak if peak > 0.0 else p) * np.sin(psi)
     if psi[0] > 0.0:
         psi, q = np.concatenate([[0.0], psi]), np.concatenate([[0.0], q])
     if psi[-1] < math.pi:
