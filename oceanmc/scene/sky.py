@@ -29,6 +29,9 @@ def pack(ill: cfg.Illumination) -> tuple[np.ndarray, np.ndarray]:
             model = registry.SKY[sky]
         else:
             theta, phi, L = sky_maps.read_sky_map(sky.map, sky.dataset, sky.layout)
+            # only the map's shape matters (the sky is scaled to Ed0's diffuse part): relative
+            # to its brightest cell, so that sums over a map near 1.7e308 cannot overflow
+            L = L / L.max()
             model = registry.SKY_MAP[sky.sampling]
         tables = sky_maps.sampling_tables(theta, phi, L)
         if model == models.SKY_MAP_COSINE:
