@@ -148,13 +148,7 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     SceneConfig."""
     if isinstance(source, (str, Path)):
         path = Path(source)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise SweepError(f"{path}: no such file") from None
-        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-            raise SweepError(f"{path}: cannot read it as YAML "
-                             f"({str(exc).splitlines()[0]})") from None
+        data = _read_yaml(path, str(path))
         folder = path.parent
     else:
         data, folder = source, Path.cwd()
@@ -178,6 +172,17 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     return SweepSpec(base, base_dir, dict(settings), axes, groups)
 
 
+def _read_yaml(path: Path, what: str) -> Any:
+    """The YAML document in path; `what` names it in the one-line error."""
+    try:
+        return yaml.safe_load(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SweepError(f"{what}: no such file ({path})") from None
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise SweepError(f"{what}: cannot read it as YAML "
+                         f"({str(exc).splitlines()[0]})") from None
+
+
 def _base_scene(base: Any, folder: Path) -> tuple[dict, Path]:
     from ..config import SceneConfig
     if base is None:
@@ -186,13 +191,7 @@ def _base_scene(base: Any, folder: Path) -> tuple[dict, Path]:
         return base.model_dump(), folder
     if isinstance(base, (str, Path)):
         path = Path(base) if Path(base).is_absolute() else folder / base
-        try:
-            scene = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise SweepError(f"base = {str(base)!r}: no such file ({path})") from None
-        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-            raise SweepError(f"base = {str(base)!r}: cannot read it as YAML "
-                             f"({str(exc).splitlines()[0]})") from None
+        scene = _read_yaml(path, f"base = {str(base)!r}")
         if not isinstance(scene, dict):
             raise SweepError(f"base = {str(base)!r}: not a scene (a mapping of keys)")
         return scene, path.parent
