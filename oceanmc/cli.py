@@ -480,6 +480,9 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as exc:
         print(f"oceanmc: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:   # before OSError, its base: `oceanmc show x.h5 | head` is fine
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except OSError as exc:
         if not hasattr(exc, "kept"):  # run.hdf5.ResultsSavedElsewhere, without importing h5py
             raise
@@ -488,9 +491,6 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("oceanmc: interrupted; no partial results file was written", file=sys.stderr)
         return 130
-    except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 1
 
 
 if __name__ == "__main__":

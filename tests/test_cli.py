@@ -38,6 +38,18 @@ def test_run_writes_results_and_prints_summary(tmp_path, scene_file):
         assert "Rrs_nadir" in f["air"]
 
 
+
+def test_show_into_a_closed_pipe_prints_no_traceback(tmp_path, scene_file):
+    """`oceanmc show x.h5 | head -1`: the reader goes away; no BrokenPipeError traceback."""
+    assert oceanmc("run", scene_file, "-o", tmp_path / "s.h5", cwd=tmp_path).returncode == 0
+    show = subprocess.Popen([sys.executable, "-m", "oceanmc", "show", tmp_path / "s.h5"],
+                            cwd=tmp_path, env=ENV, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    show.stdout.close()   # nobody reads: the first write meets a broken pipe
+    stderr = show.stderr.read().decode()
+    show.wait(timeout=120)
+    assert "Traceback" not in stderr and "BrokenPipeError" not in stderr, stderr
+
 def test_several_configs_run_in_turn_into_a_folder(tmp_path, scene_file, small_scene):
     second = tmp_path / "second.yaml"
     small_scene["name"] = "second"
