@@ -31,7 +31,8 @@ from .surface import dispatch as surface_bsdf
 @internal
 def optical_depth(medium, mf, seg, layer, z):
     """tau from the surface to depth z in segment seg (of the given layer)."""
-    return mf[medium.plane_tau + seg] + mf[medium.layer_c + layer] * (z - mf[medium.plane_z + seg])
+    return mf[medium.plane_tau + seg] + mf[medium.layer_c + layer * medium.n_wl] * (
+        z - mf[medium.plane_z + seg])
 
 
 @internal

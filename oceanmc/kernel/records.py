@@ -31,25 +31,32 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 # Water column: planes (surface first, then layer boundaries and tally depths, bottom last; z =
 # inf below an infinitely deep last layer), the segments between them, the layers, the phase
 # function components of each layer and their tables, and the upward bias per layer. The
-# per-wavelength tables hold one row per wavelength (n_wl rows; a packet reads the row of its
-# `wavelength`, the hero wavelength of a spectral walk, kernel/spectral.py).
-#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo (n_wl x
-#               n_layers); up_fraction, up_density, up_keep (n_layers); comp_cumweight (n_wl x
-#               n_comps; cumulative within each layer), comp_params (2 each);
-#               tab_psi, tab_q, tab_cdf (all tables, each component at its tab_start)
+# per-layer optics hold n_wl values per layer, layer-major (a packet reads layer * n_wl + its
+# `wavelength`, the hero wavelength of a spectral walk, kernel/spectral.py, which reads a
+# layer's wavelengths in a row).
+#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo,
+#               layer_c_over_b (n_layers x n_wl); up_fraction, up_density, up_keep (n_layers);
+#               comp_cumweight (n_wl x n_comps; cumulative within each layer), comp_params (2
+#               each); tab_psi (each distinct angle grid once, at a component's psi_start),
+#               tab_q, tab_cdf (each table at its component's tab_start); mix_coef
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
-#               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len
+#               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
+#               comp_psi_start (n_comps); mix_ptr (n_layers + 1), mix_comp, mix_at: the terms
+#               of each layer's volume scattering functions, all wavelengths side by side
+#               (scene/medium.py scattering_terms, kernel/spectral.py)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "up_cos",
-    "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
+    "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b",
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
-    "tab_psi", "tab_q", "tab_cdf",
+    "tab_psi", "tab_q", "tab_cdf", "mix_coef",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
-    "comp_tab_start", "comp_tab_len",
+    "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp", "mix_at",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
-          "layer_inv_c", "layer_albedo", "up_fraction", "up_density", "up_keep", "comp_cumweight",
-          "comp_params", "tab_psi", "tab_q", "tab_cdf", "plane_tally", "segment_layer",
-          "comp_start", "comp_count", "comp_model", "comp_tab_start", "comp_tab_len"))
+          "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
+          "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
+          "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
+          "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp",
+          "mix_at"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
@@ -76,20 +83,20 @@ SKY = _record(
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
 #               phi_edge_sin (n_phi), level_z, level_tau (n_depths)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
-#               spectral scenes: source_q (2 x n_wl: sun, sky), source_scale (2), bottom_q (n_wl)
-#   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: m, q
-#               (n_wl each), phase component values (max_comps)); then one block of wl_stride
+#               spectral scenes: source_q (2 x n_wl: sun, sky), bottom_q (n_wl)
+#   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: K, G,
+#               F (n_wl each), D, beta (n_wl)); then one block of wl_stride
 #               per wavelength: flux (n_levels x 4), radiance (n_levels x n_theta_cols x
 #               n_phi_cols), local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget
 #               (n_budget); the offsets below are those of the first block
 GRID = _record(
-    "n_wl", "wl_stride", "spectral", "source_q", "source_scale", "bottom_q",
+    "n_wl", "wl_stride", "spectral", "source_q", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
     "n_lookup", "theta_cols", "phi_cols",
     "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
     "theta_lookup", "theta_is_cap",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "wl_stride", "spectral", "source_q", "source_scale", "bottom_q",
+    ints=("n_wl", "wl_stride", "spectral", "source_q", "bottom_q",
           "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
           "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
           "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",

@@ -164,7 +164,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
     times exp(-c dist), or survival with that probability in the analog walk)."""
     seg = p.seg
     layer = mi[medium.segment_layer + seg]
-    at = p.wavelength * medium.n_layers + layer
+    at = layer * medium.n_wl + p.wavelength
     c = mf[medium.layer_c + at]
     albedo = mf[medium.layer_albedo + at]
     uz = p.uz
@@ -183,14 +183,13 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
         if s < dist:
             p.z += s * uz
             if grid.n_wl > 1:
-                spectral.flight(medium, mf, grid, tally, p, layer, s, True)
+                spectral.advance(grid, tally, s)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
         if grid.n_wl > 1 and dist < math.inf:
-            spectral.flight(medium, mf, grid, tally, p, layer, dist, False)
+            spectral.advance(grid, tally, dist)
     elif grid.n_wl > 1:
-        spectral.attenuate(medium, mf, grid, tally, p, layer, dist)
-        if dist == math.inf:
+        if spectral.attenuate(medium, mf, grid, tally, p, layer, dist):
             return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
         # no scattering and no plane ahead: down an infinitely deep clear layer, or level
@@ -205,6 +204,8 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
         else:
             tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
             p.w *= transmitted
+    if grid.n_wl > 1:
+        spectral.settle(medium, mf, grid, tally, p, layer)
     if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
         score(grid, tally, budget + BUDGET_LOST_BELOW, p.w)
         return FLIGHT_GONE, -1, 0.0
@@ -216,7 +217,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
 def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
-    albedo = mf[medium.layer_albedo + p.wavelength * medium.n_layers + layer]
+    albedo = mf[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
     w = p.w
     if est.directions_on or est.cap_on:
         local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p.seg,
@@ -226,12 +227,10 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
         if uniform(rng) >= albedo:
             tally[budget + BUDGET_LAYERS + layer] += w
             return False, 0.0
-    elif grid.n_wl > 1:
-        spectral.absorb(medium, mf, grid, tally, p, layer)
-        w = p.w
     else:
         scattered = w * albedo
-        tally[budget + BUDGET_LAYERS + layer] += w - scattered
+        if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
+            tally[budget + BUDGET_LAYERS + layer] += w - scattered
         w = scattered
     if ctrl.upward:
         w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz, rng)
@@ -240,17 +239,22 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
         cos_s = phase.sample_cos(medium, mf, mi, layer, p.wavelength, u_pick, uniform(rng))
         ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
         if grid.n_wl > 1:
-            spectral.turn(medium, mf, mi, grid, tally, p, layer, cos_s)
-            w = p.w
+            p.w = w
+            spectral.scatter(medium, mf, mi, grid, tally, p, layer, cos_s)
     p.w = w
     p.ux = ux
     p.uy = uy
     p.uz = uz
     p.beam = 0
     tau = exponential(rng)
-    if not survives_roulette(ctrl, p, rng):
+    if grid.n_wl > 1:
+        if not spectral.survives_roulette(medium, mf, ctrl, grid, tally, p, layer, rng):
+            return False, tau
+    elif not survives_roulette(ctrl, p, rng):
         return False, tau
     if events >= ctrl.max_events:
+        if grid.n_wl > 1:
+            spectral.settle(medium, mf, grid, tally, p, layer)
         score(grid, tally, budget + BUDGET_TRUNCATED, p.w)
         return False, tau
     return True, tau
@@ -285,6 +289,8 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
     p.uy = ry
     p.uz = rz
     p.seg = 0
+    if grid.n_wl > 1:
+        spectral.carry(grid, tally, p)
     return True
 
 
@@ -337,13 +343,17 @@ def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
 
 
 @internal
-def after_reflection(ctrl, grid, gf, gi, tally, stack, n_stacked, p, level, rng):
+def after_reflection(medium, mf, mi, ctrl, grid, gf, gi, tally, stack, n_stacked, p, level,
+                     rng):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
         score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
         n_stacked = split(ctrl, stack, n_stacked, p)
+    if grid.n_wl > 1:
+        return spectral.survives_roulette(medium, mf, ctrl, grid, tally, p,
+                                          mi[medium.segment_layer + p.seg], rng), n_stacked
     return survives_roulette(ctrl, p, rng), n_stacked
 
 
@@ -402,13 +412,15 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         launch(p, w, ux, uy, uz, not from_sky)
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
-            spectral.start(grid, gf, tally, p, from_sky, from_air, rng)
+            spectral.start(grid, gf, tally, p, from_sky, rng)
         if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
             beam_in[0], beam_in[1], beam_in[2], beam_in[3] = w_sun_in, sx, sy, sz
             continue
+        if grid.n_wl > 1:
+            spectral.carry(grid, tally, p)
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, stack, n_stacked, p)
         while True:
@@ -432,8 +444,9 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                         alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf,
                                                   est, ef, ei, tally, p, rng)
                     if alive and plane != PLANE_INSIDE:
-                        alive, n_stacked = after_reflection(ctrl, grid, gf, gi, tally, stack,
-                                                            n_stacked, p, level, rng)
+                        alive, n_stacked = after_reflection(medium, mf, mi, ctrl, grid, gf,
+                                                            gi, tally, stack, n_stacked, p,
+                                                            level, rng)
                 else:
                     alive = False
             events += walk_events

@@ -75,7 +75,7 @@ def build(config: cfg.SceneConfig) -> Scene:
     sk[0]["diffuse_fraction"] = grid.stratified_fraction(optics.illumination_spectrum(config)[1])
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]), len(column.albedo), column.max_comps)
+                                   len(directions[0]), len(column.albedo))
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
                  pack_estimator(config.estimator, column.albedo), angles, local_rows,

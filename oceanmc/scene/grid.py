@@ -77,27 +77,25 @@ def stratified_fraction(diffuse_fraction: np.ndarray) -> float:
     return float(np.mean(diffuse_fraction))
 
 
-def source_shares(diffuse_fraction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(source_q (2, n_wl), source_scale (2,)): each wavelength's weight of a sun (row 0) or sky
-    (row 1) photon relative to the weight the stratification gives it, (1 - f_l) / (1 - f) and
-    f_l / f (f: stratified_fraction), as shares of their largest (kernel/spectral.py)."""
+def source_shares(diffuse_fraction: np.ndarray) -> np.ndarray:
+    """source_q (2, n_wl): each wavelength's weight of a sun (row 0) or sky (row 1) photon
+    relative to the weight the stratification gives it, (1 - f_l) / (1 - f) and f_l / f (f:
+    stratified_fraction; kernel/spectral.py)."""
     f = stratified_fraction(diffuse_fraction)
     sun = (1.0 - diffuse_fraction) / (1.0 - f) if f < 1.0 else np.ones_like(diffuse_fraction)
     sky = diffuse_fraction / f if f > 0.0 else np.ones_like(diffuse_fraction)
-    rows = np.array([sun, sky])
-    scale = rows.max(axis=1)
-    return rows / scale[:, None], scale
+    return np.array([sun, sky])
 
 
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int, n_layers: int, max_comps: int = 1,
+         surface_level: int, n_dirs: int, n_layers: int,
          bottom_shares: np.ndarray | None = None
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
     (a depth profile's sublayers each absorb into a budget column of their own). A spectral
-    scene's row holds the packet's spectral state first (max_comps: phase components of the
-    layer with most), then one block per wavelength; bottom_shares: each wavelength's bottom
+    scene's row holds the packet's spectral state first (kernel/spectral.py), then one block
+    per wavelength; bottom_shares: each wavelength's bottom
     reflectance relative to the packed BRDF's (default 1)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
@@ -108,8 +106,8 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
     layout = {}
-    # the packet's spectral state (m, q per wavelength, then phase-component values)
-    size = spectral_size = 2 * n_wl + max_comps if n_wl > 1 else 0
+    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength)
+    size = spectral_size = 4 * n_wl + 1 if n_wl > 1 else 0
     for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
                          ("local", (n_depths + 1) * n_dirs), ("cap", n_depths + 1),
                          ("budget", n_budget)):
@@ -118,11 +116,10 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     wl_stride = size - spectral_size
     size = spectral_size + n_wl * wl_stride
     _, diffuse, _ = optics.illumination_spectrum(config)
-    source_q, source_scale = source_shares(diffuse)
+    source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
         GRID, n_wl=n_wl, wl_stride=wl_stride, spectral=0, source_q=f.add(source_q),
-        source_scale=f.add(source_scale),
         bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
         mu_cut=float(config.tallies.grazing_mu_cut), radiance_on=int(radiance_on),

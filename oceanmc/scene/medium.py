@@ -27,7 +27,6 @@ class Column:
     albedo: np.ndarray         # per layer
     layers: tuple              # optics.LayerIOPs of each layer (a depth profile is resolved
     #                            into several layers of one configured layer)
-    max_comps: int             # phase-function components in the layer that has most
 
 
 def _mixture(phase: cfg.Mixture) -> list:
@@ -123,18 +122,64 @@ def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) ->
                 "none (give a small b > 0)")
 
 
+def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[int],
+                     layer_b: np.ndarray, comp_model: list[int], tables: list
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(mix_ptr, mix_comp, mix_at, mix_coef): each wavelength's volume scattering function
+    beta_j = b_j sum_k share_jk p_k in layer L as the terms mix_ptr[L] .. mix_ptr[L + 1] - 1,
+    each with all wavelengths side by side (kernel/spectral.py reads them in one pass): an
+    analytic component k = mix_comp[e] with the row b_j share_jk at mix_coef[mix_at[e]:], or
+    all the tables on one angle grid mixed into one, node-major (n_nodes x n_wl) at
+    mix_coef[mix_at[e]:] (mix_comp[e]: one of them, for the grid). Tables on a grid mix exactly:
+    each is linear between the same nodes. A Case-1 water has two terms: pure water and the
+    particles' Fournier-Forand tables of every wavelength."""
+    n_wl = share.shape[0]
+    ptr, comp, at, parts = [0], [], [], []
+    size = 0
+    for layer, (first, count) in enumerate(zip(comp_start, comp_count)):
+        grids: dict[int, int] = {}      # psi offset -> term index
+        for k in range(first, first + count):
+            coef = layer_b[layer] * share[:, k]
+            if not coef.any():
+                continue
+            if comp_model[k] != models.PHASE_TABULATED:
+                comp.append(k)
+                at.append(size)
+                parts.append(coef)
+                size += n_wl
+                continue
+            psi_at, q = tables[k]
+            if psi_at not in grids:
+                grids[psi_at] = len(comp)
+                comp.append(k)
+                at.append(size)
+                parts.append(np.zeros((len(q), n_wl)))
+                size += len(q) * n_wl
+            parts[grids[psi_at]] += np.outer(q, coef)
+        ptr.append(len(comp))
+    coefs = np.concatenate([part.ravel() for part in parts]) if parts else np.zeros(0)
+    return (np.array(ptr, dtype=np.int64), np.array(comp, dtype=np.int64),
+            np.array(at, dtype=np.int64), coefs)
+
+
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
-    """(MEDIUM record, float pool, int pool, Column). Per-wavelength tables have one row per
-    wavelength; the Column's optical depths and albedo are those of the first wavelength (the
+    """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
+    values per layer; the Column's optical depths and albedo are those of the first wavelength (the
     local estimates, which only monochromatic scenes use, read them)."""
     layers = optics.column_iops(config)
     n_wl = len(config.wavelengths)
     if n_wl > 1:
         _spectral_checks(config, layers)
     comp_start, comp_count, shares, comp_model, comp_params = [], [], [], [], []
-    tab_start, tab_len, psi_parts, q_parts, cdf_parts = [], [], [], [], []
+    tab_start, tab_len, psi_start, q_parts, cdf_parts = [], [], [], [], []
+    comp_tables: list = []      # (grid offset, q) of each tabulated component
     tab_offset = 0
     table_at: dict[int, tuple[int, int]] = {}
+    # each distinct angle grid once (the Fournier-Forand tables of every wavelength share one),
+    # so that one search locates an angle in all of a layer's tables (phase/dispatch.py)
+    grid_at: dict[bytes, int] = {}
+    grid_parts: list[np.ndarray] = []
+    grid_offset = 0
     for layer in layers:
         # the components of every phase that scatters at some wavelength; each wavelength
         # weights them by its own shares (a row of zeros for phases it does not use)
@@ -148,33 +193,44 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
                 if table is None:
                     tab_start.append(0)
                     tab_len.append(0)
+                    psi_start.append(0)
+                    comp_tables.append(None)
                     continue
                 key = id(table[0])
                 if key not in table_at:
                     table_at[key] = (tab_offset, len(table[0]))
-                    psi_parts.append(table[0])
                     q_parts.append(table[1])
                     cdf_parts.append(table[2])
                     tab_offset += len(table[0])
+                psi_key = np.ascontiguousarray(table[0]).tobytes()
+                if psi_key not in grid_at:
+                    grid_at[psi_key] = grid_offset
+                    grid_parts.append(table[0])
+                    grid_offset += len(table[0])
                 tab_start.append(table_at[key][0])
                 tab_len.append(table_at[key][1])
+                psi_start.append(grid_at[psi_key])
+                comp_tables.append((grid_at[psi_key], table[1]))
         comp_count.append(len(comp_model) - comp_start[-1])
-    # cumulative shares within each layer, one row per wavelength, the last exactly 1
+    # shares within each layer, one row per wavelength; cumulative, the last exactly 1
     share = np.array(shares).T.reshape(n_wl, len(comp_model))
     cumweight = np.empty_like(share)
     for first, count in zip(comp_start, comp_count):
         part = share[:, first:first + count]
         total = part.sum(axis=1, keepdims=True)
         part = np.where(total > 0.0, part / np.where(total > 0.0, total, 1.0), 1.0 / count)
+        share[:, first:first + count] = part
         cumweight[:, first:first + count] = np.cumsum(part, axis=1)
         cumweight[:, first + count - 1] = 1.0
+    layer_b = np.array([layer.b for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
+    mix_ptr, mix_comp, mix_at, mix_coef = scattering_terms(
+        share, comp_start, comp_count, layer_b, comp_model, comp_tables)
 
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
-    layer_c = np.array([layer.c for layer in layers], dtype=np.float64).T     # (n_wl, n_layers)
-    layer_b = np.array([layer.b for layer in layers], dtype=np.float64).T
+    layer_c = np.array([layer.c for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
     albedo_all = np.divide(layer_b, layer_c, out=np.zeros_like(layer_c), where=layer_b > 0.0)
-    albedo = albedo_all[0]
-    plane_tau = optical_depths(plane_z, segment_layer, layer_c[0])
+    albedo = albedo_all[:, 0]
+    plane_tau = optical_depths(plane_z, segment_layer, layer_c[:, 0])
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
                          dtype=np.float64)
     fraction = upward_fractions(config.estimator, albedo)
@@ -189,16 +245,21 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         plane_z=f.add(plane_z), plane_tau=f.add(plane_tau), layer_c=f.add(layer_c),
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
-        layer_albedo=f.add(albedo_all), up_fraction=f.add(fraction),
+        layer_albedo=f.add(albedo_all),
+        layer_c_over_b=f.add(np.divide(layer_c, layer_b, out=np.zeros_like(layer_c),
+                                       where=layer_b > 0.0)),
+        up_fraction=f.add(fraction),
         up_density=f.add(fraction / up_solid_angle),
         up_keep=f.add(1.0 - fraction), comp_cumweight=f.add(cumweight),
         comp_params=f.add(comp_params),
-        tab_psi=f.add(np.concatenate(psi_parts) if psi_parts else np.zeros(0)),
+        tab_psi=f.add(np.concatenate(grid_parts) if grid_parts else np.zeros(0)),
         tab_q=f.add(np.concatenate(q_parts) if q_parts else np.zeros(0)),
         tab_cdf=f.add(np.concatenate(cdf_parts) if cdf_parts else np.zeros(0)),
         plane_tally=i.add(plane_tally), segment_layer=i.add(segment_layer),
         comp_start=i.add(comp_start), comp_count=i.add(comp_count),
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
-        comp_tab_len=i.add(tab_len))
-    column = Column(surface_level, depths, level_tau, albedo, tuple(layers), max(comp_count))
+        comp_tab_len=i.add(tab_len), comp_psi_start=i.add(psi_start),
+        mix_ptr=i.add(mix_ptr), mix_comp=i.add(mix_comp), mix_at=i.add(mix_at),
+        mix_coef=f.add(mix_coef))
+    column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
     return rec, f.array(), i.array(), column

@@ -19,10 +19,11 @@ def component_params(medium, mf, k):
 
 @kernel
 def table_at(medium, mi, k):
-    """(psi, q, cdf offsets, node count) of component k's table in the float pool."""
+    """(psi, q, cdf offsets, node count) of component k's table in the float pool (tables on
+    the same angle grid share its psi offset)."""
     start = mi[medium.comp_tab_start + k]
-    return (medium.tab_psi + start, medium.tab_q + start, medium.tab_cdf + start,
-            mi[medium.comp_tab_len + k])
+    return (medium.tab_psi + mi[medium.comp_psi_start + k], medium.tab_q + start,
+            medium.tab_cdf + start, mi[medium.comp_tab_len + k])
 
 
 @hot
@@ -62,30 +63,6 @@ def sample_cos(medium, mf, mi, layer, wavelength, u_pick, u):
     while k < last and u_pick >= mf[cumweight + k]:
         k += 1
     return sample_component(medium, mf, mi, k, u)
-
-
-@kernel
-def evaluate_components(medium, mf, mi, layer, cos_psi, out, at):
-    """Each component of the layer at cos_psi (1/sr) into out[at], out[at + 1], ... (once per
-    collision, for every wavelength's mixture; kernel/spectral.py)."""
-    first = mi[medium.comp_start + layer]
-    for k in range(mi[medium.comp_count + layer]):
-        out[at + k] = evaluate_component(medium, mf, mi, first + k, cos_psi)
-
-
-@kernel
-def mixture_at(medium, mf, mi, layer, wavelength, values, at):
-    """The layer's phase function at wavelength index `wavelength`: its shares of the component
-    values that evaluate_components left in values[at:]."""
-    first = mi[medium.comp_start + layer]
-    cumweight = medium.comp_cumweight + wavelength * medium.n_comps + first
-    total = 0.0
-    previous = 0.0
-    for k in range(mi[medium.comp_count + layer]):
-        weight = mf[cumweight + k] - previous
-        previous = mf[cumweight + k]
-        total += weight * values[at + k]
-    return total
 
 
 @hot

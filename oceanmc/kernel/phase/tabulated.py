@@ -32,9 +32,9 @@ def sample(pool, psi_at, q_at, cdf_at, length, u):
 
 
 @kernel
-def density(pool, psi_at, q_at, length, angle):
-    """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
-    between nodes)."""
+def locate(pool, psi_at, length, angle):
+    """(node i, fraction) with psi[i] <= angle < psi[i + 1] in the table's angle grid: where the
+    angle falls, for every table on that grid (phase/dispatch.py searches a shared grid once)."""
     lo = 0
     hi = length - 1
     while hi - lo > 1:
@@ -44,14 +44,33 @@ def density(pool, psi_at, q_at, length, angle):
         else:
             hi = mid
     psi0 = pool[psi_at + lo]
-    frac = (angle - psi0) / (pool[psi_at + lo + 1] - psi0)
-    q0 = pool[q_at + lo]
-    return q0 + frac * (pool[q_at + lo + 1] - q0)
+    return lo, (angle - psi0) / (pool[psi_at + lo + 1] - psi0)
+
+
+@kernel
+def interpolate(pool, q_at, node, frac):
+    """q at the located angle: linear between the nodes (exact for this table)."""
+    q0 = pool[q_at + node]
+    return q0 + frac * (pool[q_at + node + 1] - q0)
+
+
+@kernel
+def density(pool, psi_at, q_at, length, angle):
+    """q(angle) = 2 pi p sin(angle), the probability per unit scattering angle (exact: linear
+    between nodes)."""
+    node, frac = locate(pool, psi_at, length, angle)
+    return interpolate(pool, q_at, node, frac)
+
+
+@kernel
+def clamped_angle(cos_psi):
+    """The scattering angle, kept EDGE rad inside [0, pi]: at psi = 0 and pi both q and
+    2 pi sin psi vanish; with q linear there the ratio tends to a finite limit."""
+    return min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
 
 
 @kernel
 def evaluate(pool, psi_at, q_at, length, cos_psi):
-    """p(psi) = q / (2 pi sin psi). At psi = 0 and pi both vanish; with q linear there the ratio
-    tends to a finite limit, taken by staying EDGE rad inside the range."""
-    angle = min(math.pi - EDGE, max(EDGE, math.acos(min(1.0, max(-1.0, cos_psi)))))
+    """p(psi) = q / (2 pi sin psi)."""
+    angle = clamped_angle(cos_psi)
     return density(pool, psi_at, q_at, length, angle) / (2.0 * math.pi * math.sin(angle))
