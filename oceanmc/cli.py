@@ -328,6 +328,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from .bench import sweep
         return sweep.main(Path(args.output), quick=args.quick)
 
+    if args.surface:
+        from .bench import surface
+        return surface.main(Path(args.output), Path(args.configs), args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -423,6 +427,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--spectral", action="store_true",
                        help="only the spectral section (one history against 31 runs): "
                             "DIR/spectral.md")
+    bench.add_argument("--surface", action="store_true",
+                       help="only the rough-sea section (DIR/surface.md): photons/s and FOM "
+                            "of Rrs with the Cox-Munk surface against the flat one")
     bench.add_argument("--sweep", action="store_true",
                        help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
                             "and 2 Dask workers against a plain loop")
