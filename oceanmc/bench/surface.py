@@ -23,7 +23,7 @@ WIND_M_S = 5.0
 ABOVE_WATER = [40.0, 135.0]    # view zenith from nadir, azimuth from the sun (Mobley 1999)
 QUANTITIES = (("air/Rrs_local", 0, "Rrs exact nadir (local)"),
               ("air/Rrs_local", 1, "Rrs 40 deg, 135 deg (local)"),
-              ("air/Rrs_nadir_crossing", None, "Rrs nadir (crossing)"))
+              ("air/Rrs_nadir", None, "Rrs nadir (crossing)"))
 
 
 def surfaces(n_water: float) -> dict[str, dict]:
