@@ -75,3 +75,18 @@ def test_upward_bias_gains_quoted_are_the_committed_bench():
     assert f"FOM {bias_alone} that of" in config and f"{with_local} that of" in config
     assert f"{local_alone} with the local estimate alone, {with_local} with the bias" in readme
     assert f"the bias alone, same estimator: {bias_alone}" in readme
+
+
+def test_surface_section_reports_rough_over_flat_ratios():
+    """The rough-sea section's table: speed and FOM ratios are rough / flat of the measured
+    numbers (a swapped or inverted ratio fails)."""
+    from oceanmc.bench import surface
+
+    data = {"photons": 10, "repeats": 1, "fom_photons": 10,
+            "speed": {"flat": {"photons_per_s_1t": 4.0e6}, "rough": {"photons_per_s_1t": 1.0e6}},
+            "fom": {"flat": {"seconds": 1.0, "quantities": {"Rrs": {"value": 0.006, "fom": 100.0}}},
+                    "rough": {"seconds": 2.0,
+                              "quantities": {"Rrs": {"value": 0.0065, "fom": 30.0}}}}}
+    text = "\n".join(surface.report_lines(data))
+    assert "| rough | 1,000,000 | 0.25 |" in text
+    assert "| Rrs | 0.00600 | 0.00650 | 100 | 30 | 0.30 |" in text
