@@ -48,13 +48,13 @@ MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "up_cos",
     "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b",
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
-    "tab_psi", "tab_q", "tab_cdf", "mix_coef",
+    "tab_psi", "tab_q", "tab_cdf", "mix_coef", "hero_cdf", "hero_p",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
     "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp", "mix_at",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
           "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
           "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-          "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
+          "hero_cdf", "hero_p", "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
           "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp",
           "mix_at"))
 
@@ -123,9 +123,10 @@ ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_event
                     ints=("analog", "max_events", "splitting", "upward"))
 
 # A photon packet: position (depth z and the segment it is in or on), weight, direction of
-# travel, whether it still belongs to the collimated solar beam, and its wavelength's index.
-PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength",
-                 ints=("seg", "beam", "wavelength"))
+# travel, whether it still belongs to the collimated solar beam, and its wavelength's index (in
+# a spectral walk, the hero's, and the reference wavelength's: kernel/spectral.py scatter).
+PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength", "reference",
+                 ints=("seg", "beam", "wavelength", "reference"))
 
 # Rows on the split stack of one batch (kernel/transport.py)
 SPLIT_STACK_ROWS = 64

@@ -2,31 +2,38 @@
 importance sampling (Wilkie et al. 2014, "Hero wavelength spectral sampling", Computer Graphics
 Forum 33(4), 123-131), inside the implicit-capture walk of transport.py.
 
-Each photon draws a hero wavelength h uniformly among the scene's n wavelengths (p.wavelength);
-its path x is sampled exactly as the monochromatic walk at h samples it (free paths with c_h,
-new directions from the phase mixture at h, roulette on its weight p.w). Every wavelength l
-scores the path with the one-sample multiple-importance estimator and the balance heuristic
-(Veach 1997, PhD thesis, section 9.2.4), the techniques being the n monochromatic walks, each
-chosen with probability 1/n:
+Each photon draws a hero wavelength h (p.wavelength) with probability pi_h (MEDIUM hero_p,
+scene/medium.py hero_probabilities); its path x is sampled exactly as the monochromatic walk at
+h samples it (free paths with c_h, new directions from the phase mixture at h). Every wavelength
+l scores the path with the one-sample multiple-importance estimator and the balance heuristic
+(Veach 1997, PhD thesis, section 9.2.4), the techniques being the n monochromatic walks, walk j
+chosen with probability pi_j:
 
-    F_l(x) = f_l(x) / ((1/n) sum_j p_j(x)) = W_l(x) R_l / mean_j R_j,
+    F_l(x) = f_l(x) / sum_j pi_j p_j(x) = W_l(x) R_l / sum_j pi_j R_j,
 
 with f_l the path's contribution at l, p_j the density with which the walk at j samples x,
 W_l = f_l / p_l the weight the monochromatic walk at l carries on x and R_j = p_j(x) / p_h(x).
-Unbiased: E_h E_x[F_l] = sum_h (1/n) int p_h f_l / mean_j p_j = int f_l. Bound: R_l / mean_j R_j
-<= n, so no wavelength ever weighs more than n times what its own walk would carry on x.
+Unbiased: E_h E_x[F_l] = sum_h pi_h int p_h f_l / sum_j pi_j p_j = int f_l. Bound:
+R_l / sum_j pi_j R_j <= 1 / pi_l, so no wavelength ever weighs more than 1 / pi_l times what its
+own walk would carry on x.
 
-The walk keeps F_l = p.w G_l / mean_j K_j, with p.w a common factor (the source's weight, the
-surface's, the hero's albedos, roulette) and, per wavelength, K_j (R_j) and G_j:
+The walk keeps F_l = p.w G_l / sum_j pi_j K_j, with p.w a common factor (the source's weight,
+the surface's, the albedos, roulette) and, per wavelength, K_j (R_j) and G_j:
 - a collision at scattering angle psi multiplies G_j by beta_j(psi) / beta_h(psi) (the albedo
   times the phase function times the free-path density, b_j p_j / (b_h p_h), the hero's albedo
-  going to p.w) and K_j by (c_j p_j) / (c_h p_h): products, no exponential;
+  going to p.w) and K_j by (c_j p_j) / (c_h p_h): products, no exponential (scatter);
 - a free path of length s in a scattering layer only adds s to D; the factor exp(-(c_j - c_h)
   D) of both is applied when the packet settles (settle): on every plane (layer boundaries,
   tally depths, surface, bottom), before any score, and when a K_j grows past a bound. So a
   collision costs a few products per wavelength, and a settle one exponential per wavelength.
-- After a settle mean K = 1, so G_j is F_j / p.w, the share q_j a scorer multiplies a packet's
-  weight by (tally.score).
+- p.w follows the reference wavelength r (p.reference: the heaviest at the last roulette test):
+  a collision gives p.w the factor beta_r / beta_h and G_j beta_j / beta_r, a free path gives
+  p.w exp(-(c_r - c_h) s) at once (fly), and a settle scales G to G_r = 1. So roulette, tested
+  when p.w falls below its threshold, is tested when the wavelength that carries the packet
+  has lost weight, not whenever a strongly absorbed hero has (which cost a settle at almost
+  every collision of a red hero carrying blue light: 13 settles per photon against 3, Chl 1).
+- After a settle sum_j pi_j K_j = 1, so p.w G_j is F_j and G_j the share q_j a scorer
+  multiplies a packet's weight by (tally.score).
 - What a layer absorbs is what enters it less what leaves it: a settle adds F_j(last settle) -
   F_j(now) to the layer's absorption (the collisions' implicit capture since then, and the
   roulette's gains), and a packet that loses roulette adds what it carried at the last settle.
@@ -44,7 +51,7 @@ F at the last settle (n), D, then scratch for one collision's beta_j (n).
 """
 import math
 
-from .compile import kernel
+from .compile import internal, kernel
 from .models import BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, PHASE_TABULATED
 from .phase import dispatch as phase
 from .phase import tabulated
@@ -56,125 +63,190 @@ K_BOUND = 1e100
 
 
 @kernel
-def start(grid, gf, tally, p, from_sky, rng):
-    """A new photon: its wavelengths' shares of the source (sun or sky: grid.source_q) and its
-    hero wavelength."""
+def weights(grid, tally):
+    """Views of the packet's spectral state: K, G and F at the last settle (n_wl each). The
+    loops over wavelengths index these views from 0, which lets LLVM vectorise them (an offset
+    index of unknown sign costs a wraparound test per element; measured 2.5x slower)."""
     n = grid.n_wl
     m = grid.spectral
+    return tally[m:m + n], tally[m + n:m + 2 * n], tally[m + 2 * n:m + 3 * n]
+
+
+@kernel
+def start(medium, mf, grid, gf, tally, p, from_sky, rng):
+    """A new photon: its wavelengths' shares of the source (sun or sky: grid.source_q) and its
+    hero wavelength, drawn with probabilities MEDIUM hero_p (the reference wavelength starts as
+    the hero)."""
+    n = grid.n_wl
+    k, g, last = weights(grid, tally)
     row = grid.source_q + (n if from_sky else 0)
+    share = gf[row:row + n]
     for j in range(n):
-        tally[m + j] = 1.0
-        tally[m + n + j] = gf[row + j]
-        tally[m + 2 * n + j] = 0.0
-    tally[m + 3 * n] = 0.0
-    p.wavelength = min(n - 1, int(uniform(rng) * n))
+        k[j] = 1.0
+        g[j] = share[j]
+        last[j] = 0.0
+    tally[grid.spectral + 3 * n] = 0.0
+    u = uniform(rng)
+    h = 0
+    while h < n - 1 and u >= mf[medium.hero_cdf + h]:
+        h += 1
+    p.wavelength = h
+    p.reference = h
 
 
 @kernel
 def carry(grid, tally, p):
     """The packet's weights as they are now are what it carries on in its layer (it has just
     entered the water, or been reflected by the surface or the bottom)."""
-    n = grid.n_wl
-    g = grid.spectral + n
-    for j in range(n):
-        tally[g + n + j] = p.w * tally[g + j]
+    _, g, last = weights(grid, tally)
+    w = p.w
+    for j in range(grid.n_wl):
+        last[j] = w * g[j]
 
 
 @kernel
 def advance(grid, tally, dist):
-    """A free path of length dist in a scattering layer (its exponentials wait for settle)."""
+    """A free path of length dist to a plane in a scattering layer (its exponentials wait for
+    the plane's settle)."""
     tally[grid.spectral + 3 * grid.n_wl] += dist
+
+
+@internal
+def fly(medium, mf, grid, tally, p, layer, dist):
+    """A free path of length dist to a collision in a scattering layer: its exponentials wait
+    for the next settle, except the reference wavelength's exp(-(c_r - c_h) dist), which p.w
+    takes at once (so that p.w follows F_r; see scatter)."""
+    tally[grid.spectral + 3 * grid.n_wl] += dist
+    if p.reference != p.wavelength:
+        row = medium.layer_c + layer * grid.n_wl
+        p.w *= math.exp(-(mf[row + p.reference] - mf[row + p.wavelength]) * dist)
 
 
 @kernel
 def settle(medium, mf, grid, tally, p, layer):
-    """Applies exp(-(c_j - c_h) D) to K_j and G_j, scales them to mean K = 1 (G_j is then the
-    share q_j of p.w), and adds to the layer's absorption what each wavelength lost since the
-    last settle."""
+    """Applies the deferred exponentials (K_j times exp(-(c_j - c_h) D); G_j times
+    exp(-(c_j - c_r) D), as p.w took the reference wavelength's share in fly), scales K to
+    mean 1 and G to G_r = 1 (so p.w is F_r, and p.w G_j is F_j), and adds to the layer's
+    absorption what each wavelength lost since the last settle."""
     n = grid.n_wl
-    m = grid.spectral
-    g = m + n
-    last = m + 2 * n
-    dist = tally[m + 3 * n]
+    k, g, last = weights(grid, tally)
+    at = grid.spectral + 3 * n
+    dist = tally[at]
     row = medium.layer_c + layer * n
-    total = 0.0
+    c = mf[row:row + n]
+    r = p.reference
     if dist > 0.0:
-        c_h = mf[row + p.wavelength]
+        c_h = c[p.wavelength]
+        shift = math.exp((c[r] - c_h) * dist)
         for j in range(n):
-            factor = math.exp(-(mf[row + j] - c_h) * dist)
-            tally[m + j] *= factor
-            tally[g + j] *= factor
-            total += tally[m + j]
-        tally[m + 3 * n] = 0.0
+            factor = math.exp(-(c[j] - c_h) * dist)
+            k[j] *= factor
+            g[j] *= factor * shift
+        tally[at] = 0.0
+    hero_p = mf[medium.hero_p:medium.hero_p + n]
+    total = 0.0
+    for j in range(n):
+        total += hero_p[j] * k[j]
+    norm = 1.0 / total
+    to_reference = g[r] * norm
+    if to_reference > 0.0:
+        p.w *= to_reference
+        g_norm = norm / to_reference
     else:
-        for j in range(n):
-            total += tally[m + j]
-    norm = n / total
+        g_norm = norm
+    w = p.w
     absorbed = grid.budget + BUDGET_LAYERS + layer
+    stride = grid.wl_stride
     for j in range(n):
-        tally[m + j] *= norm
-        tally[g + j] *= norm
-        now = p.w * tally[g + j]
-        tally[absorbed + j * grid.wl_stride] += tally[last + j] - now
-        tally[last + j] = now
+        k[j] *= norm
+        g[j] *= g_norm
+        now = w * g[j]
+        tally[absorbed + j * stride] += last[j] - now
+        last[j] = now
 
 
-@kernel
-def volume_scattering(medium, mf, mi, grid, tally, layer, cos_s, beta):
-    """beta_j(psi) of every wavelength of the layer into tally[beta:beta + n_wl], from the
-    layer's terms (MEDIUM mix_*): one search per angle grid, then rows of n_wl numbers."""
-    n = grid.n_wl
+@internal
+def volume_scattering(medium, mf, mi, layer, cos_s, angle, psi_s, node_s, beta):
+    """2 pi sin(psi) beta_j(psi) of every wavelength of the layer into the view beta (n_wl),
+    from the layer's terms (MEDIUM mix_*): tables are read in these units (q, phase_tables.py),
+    and the common factor cancels in the ratios that scatter takes. A table on the angle grid
+    that the hero's direction was sampled from (psi_s) is read at the sampled node node_s, the
+    others after one search per grid; then rows of n_wl numbers."""
+    n = beta.shape[0]
     for j in range(n):
-        tally[beta + j] = 0.0
-    angle = tabulated.clamped_angle(cos_s)
-    per_density = 1.0 / (2.0 * math.pi * math.sin(angle))
+        beta[j] = 0.0
+    angle = min(math.pi - tabulated.EDGE, max(tabulated.EDGE, angle))
     for e in range(mi[medium.mix_ptr + layer], mi[medium.mix_ptr + layer + 1]):
         k = mi[medium.mix_comp + e]
         at = medium.mix_coef + mi[medium.mix_at + e]
         if mi[medium.comp_model + k] == PHASE_TABULATED:
             psi_at, _, _, length = phase.table_at(medium, mi, k)
-            node, frac = tabulated.locate(mf, psi_at, length, angle)
+            if psi_at == psi_s and mf[psi_at + node_s] <= angle <= mf[psi_at + node_s + 1]:
+                node = node_s
+                psi0 = mf[psi_at + node]
+                frac = (angle - psi0) / (mf[psi_at + node + 1] - psi0)
+            else:
+                node, frac = tabulated.locate(mf, psi_at, length, angle)
             lo = at + node * n
+            below = mf[lo:lo + n]
+            above = mf[lo + n:lo + 2 * n]
             for j in range(n):
-                q0 = mf[lo + j]
-                tally[beta + j] += (q0 + frac * (mf[lo + n + j] - q0)) * per_density
+                beta[j] += below[j] + frac * (above[j] - below[j])
         else:
-            value = phase.evaluate_component(medium, mf, mi, k, cos_s)
+            value = phase.evaluate_component(medium, mf, mi, k, cos_s) * (
+                2.0 * math.pi * math.sin(angle))
+            coef = mf[at:at + n]
             for j in range(n):
-                tally[beta + j] += mf[at + j] * value
+                beta[j] += coef[j] * value
 
 
-@kernel
-def scatter(medium, mf, mi, grid, tally, p, layer, cos_s):
-    """A collision that turned the packet by cos_s (p.w already times the hero's albedo): G_j
-    times beta_j / beta_h and K_j times (c_j p_j) / (c_h p_h) = (beta_j c_j / b_j) / (beta_h
-    c_h / b_h)."""
-    n = grid.n_wl
-    m = grid.spectral
-    g = m + n
-    beta = m + 3 * n + 1
-    volume_scattering(medium, mf, mi, grid, tally, layer, cos_s, beta)
-    row = medium.layer_c_over_b + layer * n
+@internal
+def scatter(medium, mf, mi, grid, tally, p, layer, u_pick, u):
+    """A collision (p.w already times the hero's albedo): the hero's new direction, sampled from
+    its phase mixture with u_pick (the component) and u (the angle), then per wavelength the
+    factors of F_j = p.w G_j / sum_j pi_j K_j: beta_j / beta_h (the albedo times the phase function
+    times the free-path density, relative to the hero's) and K_j times (c_j p_j) / (c_h p_h) =
+    (beta_j c_j / b_j) / (beta_h c_h / b_h). The factor beta_j / beta_h is split as
+    beta_r / beta_h on p.w and beta_j / beta_r on G_j, r the packet's reference wavelength (the
+    heaviest at the last roulette test), so p.w follows the weight that decides roulette rather
+    than the hero's: a red hero's p.w would fall below the threshold at every collision while
+    blue wavelengths still carry the packet, each time paying a settle (measured: 13 settles
+    per photon, Chl 1 deep). Returns cos(psi)."""
     h = p.wavelength
-    per_beta = 1.0 / tally[beta + h]
-    per_k = per_beta / mf[row + h]
-    top = 0.0
+    k_s = phase.pick(medium, mf, mi, layer, h, u_pick)
+    cos_s, angle, psi_s, node_s = phase.sample_angle(medium, mf, mi, k_s, u)
+    n = grid.n_wl
+    k, g, _ = weights(grid, tally)
+    at = grid.spectral + 3 * n + 1
+    beta = tally[at:at + n]
+    volume_scattering(medium, mf, mi, layer, cos_s, angle, psi_s, node_s, beta)
+    row = medium.layer_c_over_b + layer * n
+    c_over_b = mf[row:row + n]
+    r = p.reference if beta[p.reference] > 0.0 else h
+    per_ref = 1.0 / beta[r]
+    per_k = 1.0 / (beta[h] * c_over_b[h])
+    p.w *= beta[r] / beta[h]
+    # a count, not a max, of the K past the bound: an integer sum vectorises, a float max
+    # does not (measured: the loop took twice as long with the max)
+    over = 0
     for j in range(n):
-        tally[g + j] *= tally[beta + j] * per_beta
-        tally[m + j] *= tally[beta + j] * mf[row + j] * per_k
-        top = max(top, tally[m + j])
-    if top > K_BOUND:
+        g[j] *= beta[j] * per_ref
+        k_j = k[j] * (beta[j] * c_over_b[j] * per_k)
+        k[j] = k_j
+        over += k_j > K_BOUND
+    if over > 0:
         settle(medium, mf, grid, tally, p, layer)
+    return cos_s
 
 
 @kernel
 def lose(grid, tally, layer):
     """The packet lost roulette in `layer`: what it carried at its last settle stays there."""
-    n = grid.n_wl
-    last = grid.spectral + 2 * n
+    _, _, last = weights(grid, tally)
     absorbed = grid.budget + BUDGET_LAYERS + layer
-    for j in range(n):
-        tally[absorbed + j * grid.wl_stride] += tally[last + j]
+    stride = grid.wl_stride
+    for j in range(grid.n_wl):
+        tally[absorbed + j * stride] += last[j]
 
 
 @kernel
@@ -183,17 +255,20 @@ def attenuate(medium, mf, grid, tally, p, layer, dist):
     settle books the rest as absorbed); dist = inf (down an infinitely deep layer): all of it
     is absorbed there, or lost below where c_j = 0. Returns whether the packet is gone."""
     n = grid.n_wl
-    g = grid.spectral + n
+    _, g, _ = weights(grid, tally)
     row = medium.layer_c + layer * n
+    c = mf[row:row + n]
     if dist < math.inf:
         for j in range(n):
-            tally[g + j] *= math.exp(-mf[row + j] * dist)
+            g[j] *= math.exp(-c[j] * dist)
         return False
     settle(medium, mf, grid, tally, p, layer)
     absorbed = grid.budget + BUDGET_LAYERS + layer
+    stride = grid.wl_stride
+    w = p.w
     for j in range(n):
-        where = absorbed if mf[row + j] > 0.0 else grid.budget + BUDGET_LOST_BELOW
-        tally[where + j * grid.wl_stride] += p.w * tally[g + j]
+        where = absorbed if c[j] > 0.0 else grid.budget + BUDGET_LOST_BELOW
+        tally[where + j * stride] += w * g[j]
     return True
 
 
@@ -202,12 +277,14 @@ def reflect(grid, gf, tally, p, rho):
     """The bottom reflects rho (the sampled BRDF's weight, on p.w) times wavelength j's share
     bottom_q_j of the reflectance (on G_j); the rest is absorbed by the bottom."""
     n = grid.n_wl
-    g = grid.spectral + n
+    _, g, _ = weights(grid, tally)
+    share = gf[grid.bottom_q:grid.bottom_q + n]
     absorbed = grid.budget + BUDGET_BOTTOM
+    stride = grid.wl_stride
+    w = p.w
     for j in range(n):
-        kept = rho * gf[grid.bottom_q + j]
-        tally[absorbed + j * grid.wl_stride] += p.w * tally[g + j] * (1.0 - kept)
-        tally[g + j] *= gf[grid.bottom_q + j]
+        tally[absorbed + j * stride] += w * g[j] * (1.0 - rho * share[j])
+        g[j] *= share[j]
     p.w *= rho
     carry(grid, tally, p)
 
@@ -217,20 +294,24 @@ def survives_roulette(medium, mf, ctrl, grid, tally, p, layer, rng):
     """Roulette after a collision, on the largest wavelength weight max_j F_j (as transport's
     survives_roulette on p.w): a packet with p.w at or above the threshold goes on untested;
     below it, the packet settles and p.w becomes max_j F_j (G_j / max G, so F is unchanged),
-    which then plays roulette. So the exponentials of a settle are paid only near the end of a
-    walk, and a hero wavelength that is absorbed fast does not end a path that other
-    wavelengths still carry. The loser's weights stay in the layer (lose)."""
+    which then plays roulette; the heaviest wavelength becomes the reference that p.w follows
+    (scatter). So the exponentials of a settle are paid only when the packet's heaviest
+    wavelength has lost weight, and a hero wavelength that is absorbed fast does not end a path
+    that other wavelengths still carry. The loser's weights stay in the layer (lose)."""
     if p.w >= ctrl.roulette_weight:
         return True
     settle(medium, mf, grid, tally, p, layer)
     n = grid.n_wl
-    g = grid.spectral + n
+    _, g, _ = weights(grid, tally)
     top = 0.0
     for j in range(n):
-        top = max(top, tally[g + j])
+        if g[j] > top:
+            top = g[j]
+            p.reference = j
     if top > 0.0:
+        per_top = 1.0 / top
         for j in range(n):
-            tally[g + j] /= top
+            g[j] *= per_top
         p.w *= top
     if p.w >= ctrl.roulette_weight:
         return True

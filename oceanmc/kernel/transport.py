@@ -80,6 +80,7 @@ def copy_packet(dst, src):
     dst.seg = src.seg
     dst.beam = src.beam
     dst.wavelength = src.wavelength
+    dst.reference = src.reference
 
 
 @internal
@@ -183,7 +184,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
         if s < dist:
             p.z += s * uz
             if grid.n_wl > 1:
-                spectral.advance(grid, tally, s)
+                spectral.fly(medium, mf, grid, tally, p, layer, s)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
         if grid.n_wl > 1 and dist < math.inf:
@@ -236,11 +237,14 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
         w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz, rng)
     else:
         u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
-        cos_s = phase.sample_cos(medium, mf, mi, layer, p.wavelength, u_pick, uniform(rng))
-        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
         if grid.n_wl > 1:
             p.w = w
-            spectral.scatter(medium, mf, mi, grid, tally, p, layer, cos_s)
+            cos_s = spectral.scatter(medium, mf, mi, grid, tally, p, layer, u_pick,
+                                     uniform(rng))
+            w = p.w
+        else:
+            cos_s = phase.sample_cos(medium, mf, mi, layer, p.wavelength, u_pick, uniform(rng))
+        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
     p.w = w
     p.ux = ux
     p.uy = uy
@@ -412,7 +416,7 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         launch(p, w, ux, uy, uz, not from_sky)
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
-            spectral.start(grid, gf, tally, p, from_sky, rng)
+            spectral.start(medium, mf, grid, gf, tally, p, from_sky, rng)
         if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
             continue
         if i < 0:

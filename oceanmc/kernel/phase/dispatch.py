@@ -53,16 +53,36 @@ def evaluate_component(medium, mf, mi, k, cos_psi):
 
 
 @hot
-def sample_cos(medium, mf, mi, layer, wavelength, u_pick, u):
-    """cos(psi) from the layer's phase function at wavelength index `wavelength`; u_pick chooses
-    the component of a mixture with probability b_k / b (it is ignored for a single component,
-    so the caller need not draw it), u the angle."""
+def pick(medium, mf, mi, layer, wavelength, u_pick):
+    """The component of the layer's mixture at wavelength index `wavelength` that u_pick
+    chooses, with probability b_k / b."""
     k = mi[medium.comp_start + layer]
     last = k + mi[medium.comp_count + layer] - 1
     cumweight = medium.comp_cumweight + wavelength * medium.n_comps
     while k < last and u_pick >= mf[cumweight + k]:
         k += 1
-    return sample_component(medium, mf, mi, k, u)
+    return k
+
+
+@hot
+def sample_cos(medium, mf, mi, layer, wavelength, u_pick, u):
+    """cos(psi) from the layer's phase function at wavelength index `wavelength`; u_pick chooses
+    the component of a mixture (it is ignored for a single component, so the caller need not
+    draw it), u the angle."""
+    return sample_component(medium, mf, mi, pick(medium, mf, mi, layer, wavelength, u_pick), u)
+
+
+@hot
+def sample_angle(medium, mf, mi, k, u):
+    """(cos psi, psi, psi grid offset, node) sampled from component k; for a tabulated one the
+    node i of its angle grid with psi[i] <= psi <= psi[i + 1], which spares a caller that
+    evaluates tables on the same grid their search; otherwise grid offset and node are -1."""
+    if mi[medium.comp_model + k] == PHASE_TABULATED:
+        psi_at, q_at, cdf_at, length = table_at(medium, mi, k)
+        node, angle = tabulated.sample_angle(mf, psi_at, q_at, cdf_at, length, u)
+        return math.cos(angle), angle, psi_at, node
+    cos_psi = sample_component(medium, mf, mi, k, u)
+    return cos_psi, math.acos(min(1.0, max(-1.0, cos_psi))), -1, -1
 
 
 @hot

@@ -10,7 +10,8 @@ EDGE = 1e-12
 
 
 @kernel
-def sample(pool, psi_at, q_at, cdf_at, length, u):
+def sample_angle(pool, psi_at, q_at, cdf_at, length, u):
+    """(node i, angle psi) sampled by inverting the CDF, psi[i] <= psi <= psi[i + 1]."""
     lo = 0
     hi = length - 1
     while hi - lo > 1:  # cdf[lo] <= u < cdf[hi]
@@ -27,8 +28,12 @@ def sample(pool, psi_at, q_at, cdf_at, length, u):
     disc = q0 * q0 + 2.0 * slope * need
     root = q0 + math.sqrt(max(0.0, disc))
     x = 2.0 * need / root if root > 0.0 else 0.0
-    angle = min(psi1, psi0 + x)
-    return math.cos(angle)
+    return lo, min(psi1, psi0 + x)
+
+
+@kernel
+def sample(pool, psi_at, q_at, cdf_at, length, u):
+    return math.cos(sample_angle(pool, psi_at, q_at, cdf_at, length, u)[1])
 
 
 @kernel
