@@ -104,18 +104,12 @@ def carry(grid, tally, p):
         last[j] = w * g[j]
 
 
-@kernel
-def advance(grid, tally, dist):
-    """A free path of length dist to a plane in a scattering layer (its exponentials wait for
-    the plane's settle)."""
-    tally[grid.spectral + 3 * grid.n_wl] += dist
-
-
 @internal
 def fly(medium, mf, grid, tally, p, layer, dist):
-    """A free path of length dist to a collision in a scattering layer: its exponentials wait
-    for the next settle, except the reference wavelength's exp(-(c_r - c_h) dist), which p.w
-    takes at once (so that p.w follows F_r; see scatter)."""
+    """A free path of length dist in a scattering layer, to a collision or a plane: its
+    exponentials wait for the next settle (D), except the reference wavelength's
+    exp(-(c_r - c_h) dist), which p.w takes at once (so that p.w follows F_r; see scatter;
+    settle gives G_j exp(-(c_j - c_r) D) to match)."""
     tally[grid.spectral + 3 * grid.n_wl] += dist
     if p.reference != p.wavelength:
         row = medium.layer_c + layer * grid.n_wl

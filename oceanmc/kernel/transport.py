@@ -188,7 +188,7 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
         if grid.n_wl > 1 and dist < math.inf:
-            spectral.advance(grid, tally, dist)
+            spectral.fly(medium, mf, grid, tally, p, layer, dist)
     elif grid.n_wl > 1:
         if spectral.attenuate(medium, mf, grid, tally, p, layer, dist):
             return FLIGHT_GONE, -1, 0.0
