@@ -48,13 +48,13 @@ MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "up_cos",
     "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b",
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
-    "tab_psi", "tab_q", "tab_cdf", "mix_coef", "hero_cdf", "hero_p",
+    "tab_psi", "tab_q", "tab_cdf", "mix_coef",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
     "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp", "mix_at",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
           "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
           "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-          "hero_cdf", "hero_p", "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
+          "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
           "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp",
           "mix_at"))
 

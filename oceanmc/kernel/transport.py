@@ -416,7 +416,7 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         launch(p, w, ux, uy, uz, not from_sky)
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
-            spectral.start(medium, mf, grid, gf, tally, p, from_sky, rng)
+            spectral.start(grid, gf, tally, p, from_sky, rng)
         if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
             continue
         if i < 0:

@@ -122,19 +122,6 @@ def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) ->
                 "none (give a small b > 0)")
 
 
-def hero_probabilities(albedo: np.ndarray) -> np.ndarray:
-    """Each wavelength's probability of being a photon's hero (kernel/spectral.py): in
-    proportion to sqrt(1 / (1 - w0)), w0 the top layer's single-scattering albedo there (1 /
-    (1 - w0): the collisions a monochromatic walk makes). Any positive choice is unbiased; this
-    one sends more of the paths where light goes deep and far, which the short paths of a
-    strongly absorbed wavelength sample poorly (measured, 6 Case-1 scenes, 31 bands: the worst
-    band's FOM 1.1-1.5x that of equal probabilities in 5 of 6 scenes, 0.85x in the sixth). An
-    infinitely deep clear layer (w0 = 1) counts as w0 = 0.999."""
-    collisions = 1.0 / np.maximum(1e-3, 1.0 - albedo[0])
-    weight = np.sqrt(collisions)
-    return weight / weight.sum()
-
-
 def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[int],
                      layer_b: np.ndarray, comp_model: list[int], tables: list
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -247,7 +234,6 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
                          dtype=np.float64)
     fraction = upward_fractions(config.estimator, albedo)
-    hero_p = hero_probabilities(albedo_all)
     cone = math.radians(config.estimator.upward_cone_deg)
     up_cos = math.cos(cone)
     up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
@@ -274,6 +260,6 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
         comp_tab_len=i.add(tab_len), comp_psi_start=i.add(psi_start),
         mix_ptr=i.add(mix_ptr), mix_comp=i.add(mix_comp), mix_at=i.add(mix_at),
-        mix_coef=f.add(mix_coef), hero_cdf=f.add(np.cumsum(hero_p)), hero_p=f.add(hero_p))
+        mix_coef=f.add(mix_coef))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
     return rec, f.array(), i.array(), column
