@@ -109,12 +109,10 @@ class SceneConfig(_Strict):
     @property
     def nadir_local(self) -> bool:
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator (auto: unless
-        the bottom is a mirror, the sea rough or the scene has several wavelengths, whose one-history walk
-        has no local estimates yet)."""
+        the bottom is a mirror or the sea rough)."""
         mode = self.tallies.nadir_estimator
         return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom)
-                                   and self.surface.model != "cox_munk"
-                                   and len(self.wavelengths) == 1)
+                                   and self.surface.model != "cox_munk")
 
     @property
     def wavelengths(self):

@@ -17,9 +17,17 @@ direction (into_water_through_rough), an unbiased estimate with the same bounded
 
 Only upward directions are offered: their paths from a collision to the level cross no surface.
 A mirror bottom has no density to evaluate, so scenes with one do not use these estimates.
+
+A spectral walk (kernel/spectral.py) scores every wavelength j from the same collision or bottom
+reflection, with its own weight (spectral.collision_weights: the path's weight at j with the
+collision point added, w_j = F_j b_j / mean_k(K_k c_k)), phase function p_j (spectral.phase_values)
+and optical depths tau_j: the same next-event estimate, with the one-sample MIS weight of the
+path that led to it. The weights, optical depths and phase values of one event live in a scratch
+at the head of the tally row (GRID.scratch, n_wl each), a one-wavelength scene's too.
 """
 import math
 
+from . import spectral
 from .brdf import dispatch as brdf
 from .compile import internal
 from .geometry import from_angles
@@ -29,10 +37,20 @@ from .surface import dispatch as surface_bsdf
 
 
 @internal
-def optical_depth(medium, mf, seg, layer, z):
-    """tau from the surface to depth z in segment seg (of the given layer)."""
-    return mf[medium.plane_tau + seg] + mf[medium.layer_c + layer * medium.n_wl] * (
-        z - mf[medium.plane_z + seg])
+def scratch(grid, tally):
+    """Views (n_wl each) of one event's weight at each wavelength, optical depth there, and
+    phase function toward the direction being scored."""
+    n = grid.n_wl
+    m = grid.scratch
+    return tally[m:m + n], tally[m + n:m + 2 * n], tally[m + 2 * n:m + 3 * n]
+
+
+@internal
+def optical_depth(medium, mf, seg, layer, z, j):
+    """tau at wavelength index j from the surface to depth z in segment seg (of the given
+    layer)."""
+    return mf[medium.plane_tau + j * medium.n_planes + seg] + mf[
+        medium.layer_c + layer * medium.n_wl + j] * (z - mf[medium.plane_z + seg])
 
 
 @internal
@@ -43,37 +61,56 @@ def direction(est, ef, k):
 
 
 @internal
-def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu):
-    """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
-    t/n^2; 0 if it is not scored there)."""
-    n_dirs = est.n_dirs
-    if ei[est.in_water + k]:
-        for level in range(grid.n_depths):
-            if gf[grid.level_z + level] <= z:
-                tally[grid.local + level * n_dirs + k] += base * math.exp(
-                    -(tau_here - gf[grid.level_tau + level]) / mu)
-    factor = ef[est.air_factor + k]
-    if factor > 0.0:
-        tally[grid.local + grid.n_depths * n_dirs + k] += base * math.exp(-tau_here / mu) * factor
+def layer_phase(medium, mf, mi, grid, layer, cos_psi, out):
+    """The layer's phase function p_j(cos_psi) in 1/sr at every wavelength into out."""
+    if grid.n_wl == 1:
+        out[0] = phase.evaluate(medium, mf, mi, layer, cos_psi)
+    else:
+        spectral.phase_values(medium, mf, mi, layer, cos_psi, out)
 
 
 @internal
-def cap_lookup(est, ef, table, cos_alpha):
-    """(M0, M1) of the water cap and of the air cap's water side for a packet whose direction
-    makes the angle acos(cos_alpha) with straight up; linear in alpha on two uniform pieces."""
+def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu, j):
+    """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
+    t/n^2; 0 if it is not scored there), at wavelength index j."""
+    n_dirs = est.n_dirs
+    local = grid.local + j * grid.wl_stride
+    taus = grid.level_tau + j * grid.n_depths
+    if ei[est.in_water + k]:
+        for level in range(grid.n_depths):
+            if gf[grid.level_z + level] <= z:
+                tally[local + level * n_dirs + k] += base * math.exp(
+                    -(tau_here - gf[taus + level]) / mu)
+    factor = ef[est.air_factor + k]
+    if factor > 0.0:
+        tally[local + grid.n_depths * n_dirs + k] += base * math.exp(-tau_here / mu) * factor
+
+
+@internal
+def cap_node(est, cos_alpha):
+    """(i, f): the node of the cap tables' alpha grid below the angle acos(cos_alpha) between
+    a packet's direction and straight up, and the fraction of the way to the next; the grid is
+    uniform on two pieces."""
     alpha = math.acos(min(1.0, max(-1.0, cos_alpha)))
     if alpha < est.fine_end:
         x = alpha / est.fine_step
     else:
         x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
     i = min(int(x), est.n_alpha - 2)
-    f = x - i
+    return i, x - i
+
+
+@internal
+def cap_lookup(est, ef, table, i, f, n_wl, j):
+    """(M0, M1) of the water cap and of the air cap's water side at wavelength index j of
+    table `table`, linear in alpha between nodes i and i + 1 (cap_node)."""
     g = 1.0 - f
-    at = table * est.n_alpha + i
-    return (g * ef[est.cap_m0w + at] + f * ef[est.cap_m0w + at + 1],
-            g * ef[est.cap_m1w + at] + f * ef[est.cap_m1w + at + 1],
-            g * ef[est.cap_m0a + at] + f * ef[est.cap_m0a + at + 1],
-            g * ef[est.cap_m1a + at] + f * ef[est.cap_m1a + at + 1])
+    at = (table * est.n_alpha + i) * n_wl + j
+    up = at + n_wl
+    return (g * ef[est.cap_m0w + at] + f * ef[est.cap_m0w + up],
+            g * ef[est.cap_m1w + at] + f * ef[est.cap_m1w + up],
+            g * ef[est.cap_m0a + at] + f * ef[est.cap_m0a + up],
+            g * ef[est.cap_m1a + at] + f * ef[est.cap_m1a + up])
 
 
 @internal
@@ -95,89 +132,134 @@ def into_water_through_rough(surface, est, ef, k, rng):
 
 
 @internal
-def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, seg, layer, z,
-                 w_scattered, ux, uy, uz, rng):
-    """What one collision of a packet travelling (ux, uy, uz) sends into the exact directions
-    (at every level above it and 0+), and the polar-cap average of the nadir-viewing radiance
-    (see scene/estimates.py for the expansion and its accuracy). The levels are sorted by
-    depth: the transmission to the deepest one above is one exp, and each level up multiplies
-    it by the transmission between the two levels (level_decay), so the cap costs two exps
-    (water and air) whatever the number of levels."""
-    tau_here = optical_depth(medium, mf, seg, layer, z)
-    if est.directions_on:
-        rough = surface.delta == 0
-        for k in range(est.n_dirs):
-            if rough and ef[est.air_factor + k] > 0.0:
-                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
-                if t > 0.0 and iz < 0.0:
-                    p = phase.evaluate(medium, mf, mi, layer, ux * ix + uy * iy + uz * iz)
-                    tally[grid.local + grid.n_depths * est.n_dirs + k] += (
-                        w_scattered * p * t * math.exp(tau_here / iz) / -iz
-                        * ef[est.air_factor + k])
-                continue
-            dx, dy, dz = direction(est, ef, k)
-            mu = -dz
-            p = phase.evaluate(medium, mf, mi, layer, ux * dx + uy * dy + uz * dz)
-            add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, w_scattered * p / mu, mu)
-    if est.cap_on:
-        m0w, m1w, m0a, m1a = cap_lookup(est, ef, ei[est.table_of_layer + layer], -uz)
-        mu = est.mu_w
-        above = 0
-        while above < grid.n_depths and gf[grid.level_z + above] <= z:
-            above += 1
-        if above > 0:
-            transmitted = math.exp(-(tau_here - gf[grid.level_tau + above - 1]) / mu)
-            scale = w_scattered / (mu * est.omega_w)
-            for level in range(above - 1, -1, -1):
-                dtau = tau_here - gf[grid.level_tau + level]
-                tally[grid.cap + level] += scale * transmitted * (m0w + m1w * (dtau / mu - 1.0)
-                                                                  / mu)
-                transmitted *= ef[est.level_decay + level]
-        mu = est.mu_a
-        e = math.exp(-tau_here / mu)
-        tally[grid.cap + grid.n_depths] += w_scattered * e * (
-            m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a
+def cap_from_collision(est, ef, grid, gf, tally, z, tau_here, w_scattered, m0w, m1w, m0a, m1a,
+                       j):
+    """The polar-cap average of the nadir-viewing radiance that a collision at depth z sends
+    to every level above it and to 0+, at wavelength index j (see scene/estimates.py for the
+    expansion and its accuracy). The levels are sorted by depth: the transmission to the
+    deepest one above is one exp, and each level up multiplies it by the transmission between
+    the two levels (level_decay), so the cap costs two exps (water and air) whatever the
+    number of levels."""
+    block = j * grid.wl_stride
+    taus = grid.level_tau + j * grid.n_depths
+    mu = est.mu_w
+    above = 0
+    while above < grid.n_depths and gf[grid.level_z + above] <= z:
+        above += 1
+    if above > 0:
+        decay = est.level_decay + j * grid.n_depths
+        transmitted = math.exp(-(tau_here - gf[taus + above - 1]) / mu)
+        scale = w_scattered / (mu * est.omega_w)
+        for level in range(above - 1, -1, -1):
+            dtau = tau_here - gf[taus + level]
+            tally[grid.cap + block + level] += scale * transmitted * (
+                m0w + m1w * (dtau / mu - 1.0) / mu)
+            transmitted *= ef[decay + level]
+    mu = est.mu_a
+    e = math.exp(-tau_here / mu)
+    tally[grid.cap + block + grid.n_depths] += w_scattered * e * (
+        m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a
 
 
 @internal
-def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, w, ux, uy, uz,
-              rng):
-    """A packet of weight w travelling (ux, uy, uz) meets the bottom (in the BRDF's local frame
-    (x, -y, -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
+def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer, w_scattered,
+                 rng):
+    """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene)
+    sends into the exact directions (at every level above it and 0+), and the polar-cap
+    average of the nadir-viewing radiance, at every wavelength."""
+    n = grid.n_wl
+    weight, tau, phase_j = scratch(grid, tally)
+    if n == 1:
+        weight[0] = w_scattered
+        tau[0] = optical_depth(medium, mf, p.seg, layer, p.z, 0)
+    else:
+        spectral.collision_weights(medium, mf, grid, tally, p, layer, weight, tau)
+    z = p.z
+    ux, uy, uz = p.ux, p.uy, p.uz
+    if est.directions_on:
+        rough = surface.delta == 0
+        for k in range(est.n_dirs):
+            factor = ef[est.air_factor + k]
+            if rough and factor > 0.0:
+                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
+                if t > 0.0 and iz < 0.0:
+                    layer_phase(medium, mf, mi, grid, layer, ux * ix + uy * iy + uz * iz,
+                                phase_j)
+                    at = grid.local + grid.n_depths * est.n_dirs + k
+                    for j in range(n):
+                        tally[at + j * grid.wl_stride] += (
+                            weight[j] * phase_j[j] * t * math.exp(tau[j] / iz) / -iz * factor)
+                continue
+            dx, dy, dz = direction(est, ef, k)
+            mu = -dz
+            layer_phase(medium, mf, mi, grid, layer, ux * dx + uy * dy + uz * dz, phase_j)
+            for j in range(n):
+                add_to_levels(est, ef, ei, grid, gf, tally, z, tau[j], k,
+                              weight[j] * phase_j[j] / mu, mu, j)
+    if est.cap_on:
+        i, f = cap_node(est, -uz)
+        table = ei[est.table_of_layer + layer]
+        for j in range(n):
+            m0w, m1w, m0a, m1a = cap_lookup(est, ef, table, i, f, n, j)
+            cap_from_collision(est, ef, grid, gf, tally, z, tau[j], weight[j], m0w, m1w, m0a,
+                               m1a, j)
+
+
+@internal
+def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, rng):
+    """Packet p meets the bottom travelling (ux, uy, uz) (in the BRDF's local frame (x, -y,
+    -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
     directions, and the polar-cap average from one direction W drawn uniformly in the cap (an
     unbiased estimate of the cap average; f is bounded for every non-mirror BRDF), once in
-    water and once for the air cap, through the surface's transmittance."""
+    water and once for the air cap, through the surface's transmittance; at every wavelength
+    (one BRDF shape, each wavelength's reflectance share in its weight)."""
+    n = grid.n_wl
+    weight, tau, _ = scratch(grid, tally)
     bottom_plane = medium.n_planes - 1
+    if n == 1:
+        weight[0] = p.w
+        tau[0] = mf[medium.plane_tau + bottom_plane]
+    else:
+        spectral.bottom_weights(medium, mf, grid, gf, tally, p, weight, tau)
     z = mf[medium.plane_z + bottom_plane]
-    tau_b = mf[medium.plane_tau + bottom_plane]
+    ux, uy, uz = p.ux, p.uy, p.uz
     model = bottom.model
     if est.directions_on:
         rough = surface.delta == 0
         for k in range(est.n_dirs):
-            if rough and ef[est.air_factor + k] > 0.0:
+            factor = ef[est.air_factor + k]
+            if rough and factor > 0.0:
                 ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
                 if t > 0.0 and iz < 0.0:
                     f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz)
-                    tally[grid.local + grid.n_depths * est.n_dirs + k] += (
-                        w * f * t * math.exp(tau_b / iz) * ef[est.air_factor + k])
+                    at = grid.local + grid.n_depths * est.n_dirs + k
+                    for j in range(n):
+                        tally[at + j * grid.wl_stride] += (
+                            weight[j] * f * t * math.exp(tau[j] / iz) * factor)
                 continue
             dx, dy, dz = direction(est, ef, k)
             f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
-            add_to_levels(est, ef, ei, grid, gf, tally, z, tau_b, k, w * f, -dz)
+            for j in range(n):
+                add_to_levels(est, ef, ei, grid, gf, tally, z, tau[j], k, weight[j] * f, -dz, j)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, oz)
-        for level in range(grid.n_depths):
-            if gf[grid.level_z + level] <= z:
-                tally[grid.cap + level] += w * f * math.exp(
-                    -(tau_b - gf[grid.level_tau + level]) / mu)
-        n = surface.n_water
+        for j in range(n):
+            block = grid.cap + j * grid.wl_stride
+            taus = grid.level_tau + j * grid.n_depths
+            for level in range(grid.n_depths):
+                if gf[grid.level_z + level] <= z:
+                    tally[block + level] += weight[j] * f * math.exp(
+                        -(tau[j] - gf[taus + level]) / mu)
+        n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
-        sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n
+        sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n_water
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
         t = surface_bsdf.transmittance(surface, mu_w)
         phi = 2.0 * math.pi * uniform(rng)
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, sin_w * math.cos(phi),
                                 -sin_w * math.sin(phi), mu_w)
-        tally[grid.cap + grid.n_depths] += w * f * math.exp(-tau_b / mu_w) * t / (n * n)
+        for j in range(n):
+            tally[grid.cap + j * grid.wl_stride + grid.n_depths] += (
+                weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

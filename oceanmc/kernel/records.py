@@ -34,7 +34,7 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 # per-layer optics hold n_wl values per layer, layer-major (a packet reads layer * n_wl + its
 # `wavelength`, the hero wavelength of a spectral walk, kernel/spectral.py, which reads a
 # layer's wavelengths in a row).
-#   float pool: plane_z, plane_tau (n_planes); layer_c, layer_inv_c, layer_albedo,
+#   float pool: plane_z (n_planes), plane_tau (n_wl x n_planes); layer_c, layer_inv_c, layer_albedo,
 #               layer_c_over_b (n_layers x n_wl); up_fraction, up_density, up_keep (n_layers);
 #               comp_cumweight (n_wl x n_comps; cumulative within each layer), comp_params (2
 #               each); tab_psi (each distinct angle grid once, at a component's psi_start),
@@ -81,22 +81,24 @@ SKY = _record(
 #   levels: the in-water tally depths (n_depths), then air (0+, all light), then air_leaving
 #   (0+, water-leaving light only).
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
-#               phi_edge_sin (n_phi), level_z, level_tau (n_depths)
+#               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
 #               spectral scenes: source_q (2 x n_wl: sun, sky), bottom_q (n_wl)
 #   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: K, G,
-#               F (n_wl each), D, beta (n_wl)); then one block of wl_stride
+#               F (n_wl each), D, beta (n_wl)); every scene: the local estimates' scratch
+#               (kernel/local_estimate.py: weight, tau, phase (n_wl each)); then one block of
+#               wl_stride
 #               per wavelength: flux (n_levels x 4), radiance (n_levels x n_theta_cols x
 #               n_phi_cols), local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget
 #               (n_budget); the offsets below are those of the first block
 GRID = _record(
-    "n_wl", "wl_stride", "spectral", "source_q", "bottom_q",
+    "n_wl", "wl_stride", "spectral", "scratch", "source_q", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
     "n_lookup", "theta_cols", "phi_cols",
     "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
     "theta_lookup", "theta_is_cap",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "wl_stride", "spectral", "source_q", "bottom_q",
+    ints=("n_wl", "wl_stride", "spectral", "scratch", "source_q", "bottom_q",
           "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
           "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
           "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",
@@ -105,7 +107,8 @@ GRID = _record(
 # Local (next-event) estimates (kernel/local_estimate.py): exact upward directions, and the
 # nadir polar-cap average (tables from scene/estimates.py).
 #   float pool: dirs (n_dirs x 3), air_factor (n_dirs), cap_m0w, cap_m1w, cap_m0a, cap_m1a
-#               (n_tables x n_alpha each), level_decay (n_depths)
+#               (n_tables x n_alpha x n_wl each; a table holds all wavelengths of a layer),
+#               level_decay (n_wl x n_depths)
 #   int pool:   in_water (n_dirs), table_of_layer (n_layers)
 ESTIMATES = _record(
     "directions_on", "cap_on", "n_dirs", "n_alpha",

@@ -191,6 +191,62 @@ def volume_scattering(medium, mf, mi, layer, cos_s, angle, psi_s, node_s, beta):
 
 
 @internal
+def phase_values(medium, mf, mi, layer, cos_psi, out):
+    """p_j(psi) in 1/sr of every wavelength of the layer into the view out (n_wl): the volume
+    scattering function over b_j, from the same terms as the collisions' ratios (a local
+    estimate toward a fixed direction; tables read after one search per angle grid)."""
+    angle = tabulated.clamped_angle(cos_psi)
+    volume_scattering(medium, mf, mi, layer, cos_psi, angle, -1, -1, out)
+    n = out.shape[0]
+    row = layer * n
+    c_over_b = mf[medium.layer_c_over_b + row:medium.layer_c_over_b + row + n]
+    inv_c = mf[medium.layer_inv_c + row:medium.layer_inv_c + row + n]
+    per_angle = 1.0 / (2.0 * math.pi * math.sin(angle))
+    for j in range(n):
+        out[j] *= per_angle * c_over_b[j] * inv_c[j]
+
+
+@internal
+def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
+    """What a collision of the packet sends at each wavelength, as a local estimate needs it:
+    the packet settles (p.w G_j = F_j, mean K = 1), then adding the collision point to the path
+    gives wavelength j the factor b_j (its scattering) and each density K_k the factor c_k (its
+    collision density), so weight_j = p.w G_j b_j / mean_k(K_k c_k) (one wavelength: w b / c,
+    the implicit-capture weight); tau_j: the optical depth at the packet."""
+    settle(medium, mf, grid, tally, p, layer)
+    n = grid.n_wl
+    k, g, _ = weights(grid, tally)
+    row = medium.layer_c + layer * n
+    c = mf[row:row + n]
+    albedo = mf[medium.layer_albedo + layer * n:medium.layer_albedo + layer * n + n]
+    total = 0.0
+    for j in range(n):
+        total += k[j] * c[j]
+    scale = p.w * n / total
+    seg = p.seg
+    dz = p.z - mf[medium.plane_z + seg]
+    taus = medium.plane_tau + seg
+    for j in range(n):
+        weight[j] = scale * g[j] * albedo[j] * c[j]
+        tau[j] = mf[taus + j * medium.n_planes] + c[j] * dz
+
+
+@internal
+def bottom_weights(medium, mf, grid, gf, tally, p, weight, tau):
+    """What a bottom reflection sends at each wavelength, as a local estimate needs it (the
+    packet settled on reaching the bottom plane): weight_j = p.w G_j bottom_q_j, times the
+    BRDF the estimate evaluates; tau_j: the bottom's optical depth."""
+    n = grid.n_wl
+    _, g, _ = weights(grid, tally)
+    share = gf[grid.bottom_q:grid.bottom_q + n]
+    taus = medium.plane_tau + medium.n_planes - 1
+    w = p.w
+    for j in range(n):
+        weight[j] = w * g[j] * share[j]
+        tau[j] = mf[taus + j * medium.n_planes]
+
+
+@internal
 def scatter(medium, mf, mi, grid, tally, p, layer, u_pick, u):
     """A collision (p.w already times the hero's albedo): the hero's new direction, sampled from
     its phase mixture with u_pick (the component) and u (the angle), then per wavelength the

@@ -219,10 +219,10 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, laye
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     a new direction, roulette. Returns (alive, optical depth to the next collision)."""
     albedo = mf[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
+    if est.directions_on or est.cap_on:   # (a spectral walk settles there: p.w may change)
+        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p,
+                                    layer, p.w * albedo, rng)
     w = p.w
-    if est.directions_on or est.cap_on:
-        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p.seg,
-                                    layer, p.z, w * albedo, p.ux, p.uy, p.uz, rng)
     budget = grid.budget
     if ctrl.analog:
         if uniform(rng) >= albedo:
@@ -310,7 +310,7 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
         return False
     if est.directions_on or est.cap_on:
         local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
-                                 p.w, p.ux, p.uy, p.uz, rng)
+                                 p, rng)
     ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, uniform(rng),
                                    uniform(rng))
     p.ux = ux

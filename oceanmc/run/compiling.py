@@ -71,7 +71,7 @@ def parts() -> dict[str, list[tuple]]:
         "entry": [(trace_batch, (row_medium, f8, i8, row_surface, row_bottom, f8, row_sky, f8,
                                  row_grid, f8, i8, row_est, f8, i8, row_ctrl, int64, int64, int64,
                                  u8, f8, f8, row_packet, row_packet)),
-                  (layer_density, (medium, f8, i8, int64, f8)),
+                  (layer_density, (medium, f8, i8, int64, int64, f8)),
                   (transmittance, (surface, float64))],
     }
 

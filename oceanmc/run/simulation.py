@@ -151,7 +151,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
     n_wl = len(config.wavelengths)
     raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
-    ed0 = illumination_spectrum(config)[0]
+    ed0, diffuse, _ = illumination_spectrum(config)
     args = sc.kernel_args()
     # a batch's lock is held through each of its calls, so that a checkpoint copies its state
     # between two calls
@@ -212,8 +212,6 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "photons_per_s": photons / wall if wall > 0 else float("inf"),
             "scattering_events": int(events[:done].sum()),
         }
-        # local estimates (and so the reflected light in exact view directions) are
-        # monochromatic only: a spectral scene has none (config/scene.py refuses them)
         reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
         per_wavelength = []
@@ -221,7 +219,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             part = {name: values[:done] for name, values in raw.items()}
             part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
             if reflected is not None:
-                part["reflected_local"] = reflected
+                part["reflected_local"] = scene.surface.reflected_at(reflected, ed0[k],
+                                                                     diffuse[k])
             per_wavelength.append(from_tallies(
                 part, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
                 config.tallies.radiance, attrs, config.tallies.local_directions_deg,

@@ -64,24 +64,20 @@ def cumulative(density, breaks: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.
             np.concatenate([[0.0], np.cumsum(mass_cos)]))
 
 
-def cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], beta: float, mu_bar: float,
-                alphas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(M0, M1) at each alpha for a cap of half-angle beta, from the cumulative integrals of q
-    (see cumulative). Circles of radius psi <= beta - alpha lie wholly in the cap; for the
-    others the probability between neighbouring quadrature angles (exact, from the cumulative
-    integral) is weighted by the share of the circle in the cap at their midpoint."""
-    psi_grid, cdf, cdf_cos = table
+def cap_geometry(beta: float, mu_bar: float, alphas: np.ndarray) -> tuple:
+    """What cap_moments needs of a cap of half-angle beta (mean cosine mu_bar) at each alpha,
+    whatever the phase function: the angles of the circles wholly inside it, the quadrature
+    angles psi of the others, and per interval between them the share of its circle inside the
+    cap (phi0 / pi) and that arc's mean cosine to the axis times the share. Built once for all the phase
+    functions of a scene (the trigonometry costs ten times one table's interpolation)."""
     alpha = alphas[:, None]
     inside = np.clip(beta - alphas, 0.0, None)
-    m0 = np.interp(inside, psi_grid, cdf)
-    m1 = np.cos(alphas) * np.interp(inside, psi_grid, cdf_cos)
     lo = np.abs(alphas - beta)[:, None]
     hi = np.minimum(math.pi, alphas + beta)[:, None]
     s = np.unique(np.concatenate([np.linspace(0.0, 1.0, PSI_NODES),
                                   np.geomspace(1e-7, 1.0, PSI_NODES),
                                   1.0 - np.geomspace(1e-7, 1.0, PSI_NODES)]))
     psi = lo + (hi - lo) * s[None, :]
-    mass = np.diff(np.interp(psi, psi_grid, cdf), axis=1)
     mid = 0.5 * (psi[:, 1:] + psi[:, :-1])
     with np.errstate(invalid="ignore", divide="ignore"):
         x = (math.cos(beta) - np.cos(alpha) * np.cos(mid)) / (np.sin(alpha) * np.sin(mid))
@@ -89,6 +85,21 @@ def cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], beta: float, m
     # mean of cos(angle to the axis) over the arc |phi| < phi0, times the arc's share
     arc_mu = (phi0 * np.cos(alpha) * np.cos(mid)
               + np.sin(alpha) * np.sin(mid) * np.sin(phi0)) / math.pi
+    return inside, np.cos(alphas), psi, phi0, arc_mu, mu_bar
+
+
+def cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], geometry: tuple
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(M0, M1) at each alpha for the cap of `geometry` (cap_geometry), from the cumulative
+    integrals of q (see cumulative). Circles of radius psi <= beta - alpha lie wholly in the
+    cap; for the others the probability between neighbouring quadrature angles (exact, from the
+    cumulative integral) is weighted by the share of the circle in the cap at their
+    midpoint."""
+    psi_grid, cdf, cdf_cos = table
+    inside, cos_alpha, psi, phi0, arc_mu, mu_bar = geometry
+    m0 = np.interp(inside, psi_grid, cdf)
+    m1 = cos_alpha * np.interp(inside, psi_grid, cdf_cos)
+    mass = np.diff(np.interp(psi, psi_grid, cdf), axis=1)
     m0 = m0 + np.sum(mass * phi0 / math.pi, axis=1)
     m1 = m1 + np.sum(mass * arc_mu, axis=1)
     return m0, m1 - mu_bar * m0

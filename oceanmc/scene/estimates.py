@@ -3,6 +3,7 @@ of the exact upward directions, and the tables of the nadir polar-cap estimate (
 for each distinct layer phase function."""
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import os
@@ -61,31 +62,33 @@ _CAP_SOURCE = hashlib.sha1(Path(cap_tables.__file__).read_bytes()).digest()
 
 
 def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) -> bytes:
-    """A digest of the layer's phase function: its components' models, weights, parameters and
-    tables."""
+    """A digest of the layer's phase functions: its components' models, weights at every
+    wavelength, parameters and tables."""
     m = medium[0]
     first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
+    n_comps = int(m["n_comps"])
     digest = hashlib.sha1()
     for k in range(first, first + count):
         start, length = mi[m["comp_tab_start"] + k], mi[m["comp_tab_len"] + k]
-        digest.update(np.array([mi[m["comp_model"] + k], mf[m["comp_cumweight"] + k],
-                                mf[m["comp_params"] + 2 * k], mf[m["comp_params"] + 2 * k + 1]])
-                      .tobytes())
+        weights = mf[m["comp_cumweight"] + k:m["comp_cumweight"] + n_comps * int(m["n_wl"]):
+                     n_comps]
+        digest.update(np.concatenate([[mi[m["comp_model"] + k]], weights,
+                                      [mf[m["comp_params"] + 2 * k],
+                                       mf[m["comp_params"] + 2 * k + 1]]]).tobytes())
         digest.update(mf[m["tab_q"] + start:m["tab_q"] + start + length].tobytes())
         digest.update(mf[m["tab_psi"] + start:m["tab_psi"] + start + length].tobytes())
     return digest.digest()
 
 
-def layer_cap_moments(medium, mf, mi, layer: int, geometry: tuple, alphas: np.ndarray
-                      ) -> list[np.ndarray]:
-    """[M0, M1] of the water cap and of the air cap's water side for one layer's phase function,
-    remembered by the phase function's content, within the process and on disk."""
-    key = hashlib.sha1(_CAP_SOURCE + np.array(geometry).tobytes() + alphas.tobytes()
-                       + layer_key(medium, mf, mi, layer)).digest()
+def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes) -> np.ndarray:
+    """(4, n_alpha, n_wl): M0 and M1 of the water cap and of the air cap's water side for the
+    layer's phase function at each wavelength (caps(): the two caps' cap_tables.cap_geometry,
+    built only if some table is), remembered by key (the phase functions' content and the
+    geometry) within the process and on disk."""
     path = _CAP_DIR / f"{key.hex()}.npy"
     if key not in _CAP_CACHE and path.exists():
         try:
-            _CAP_CACHE[key] = list(np.load(path))
+            _CAP_CACHE[key] = np.load(path)
         except (OSError, ValueError):
             pass   # unreadable: computed again below
     if key not in _CAP_CACHE:
@@ -95,14 +98,26 @@ def layer_cap_moments(medium, mf, mi, layer: int, geometry: tuple, alphas: np.nd
             [mf[m["tab_psi"] + mi[m["comp_tab_start"] + k]:
                 m["tab_psi"] + mi[m["comp_tab_start"] + k] + mi[m["comp_tab_len"] + k]]
              for k in range(first, first + count)] + [np.zeros(0)])
-        beta, mu_w, beta_w, mu_a = geometry
-        table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, psi), breaks)
-        _CAP_CACHE[key] = [*cap_tables.cap_moments(table, beta, mu_w, alphas),
-                           *cap_tables.cap_moments(table, beta_w, mu_a, alphas)]
+        n_wl, n_comps = int(m["n_wl"]), int(m["n_comps"])
+        water, air = caps()
+        out = np.empty((4, len(water[1]), n_wl))
+        done: dict[bytes, int] = {}   # wavelengths with the same phase function share moments
+        for j in range(n_wl):
+            at = m["comp_cumweight"] + j * n_comps + first
+            same = mf[at:at + count].tobytes()   # the same components' weights: the same p
+            if same in done:
+                out[:, :, j] = out[:, :, done[same]]
+                continue
+            done[same] = j
+            table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, j, psi),
+                                          breaks)
+            out[:, :, j] = [*cap_tables.cap_moments(table, water),
+                            *cap_tables.cap_moments(table, air)]
+        _CAP_CACHE[key] = out
         try:   # atomically, so that a concurrent run never reads half a file
             _CAP_DIR.mkdir(parents=True, exist_ok=True)
             with tempfile.NamedTemporaryFile(dir=_CAP_DIR, suffix=".npy", delete=False) as f:
-                np.save(f, np.array(_CAP_CACHE[key]))
+                np.save(f, out)
             os.replace(f.name, path)
             kept = sorted(_CAP_DIR.glob("*.npy"), key=lambda p: p.stat().st_mtime)
             for old in kept[:-_CAP_FILES_KEPT]:
@@ -127,17 +142,24 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     fine_end, fine_step, coarse_step, fine_nodes = cap_tables.alpha_grid(beta)
     alphas = cap_tables.alpha_nodes(beta)
     enabled = config.nadir_local
+    n_wl = len(config.wavelengths)
+    geometry = (beta, mu_w, beta_w, mu_a)
+
+    @functools.cache
+    def caps():
+        return (cap_tables.cap_geometry(beta, mu_w, alphas),
+                cap_tables.cap_geometry(beta_w, mu_a, alphas))
+
     tables: dict[bytes, int] = {}
     table_of_layer = []
-    moments = {"m0w": [], "m1w": [], "m0a": [], "m1a": []}
+    moments = []    # per table (4, n_alpha, n_wl): M0, M1 of the water cap, then the air cap
     for layer in range(len(column.albedo)):
-        key = layer_key(medium, mf, mi, layer) if enabled else b""
+        key = hashlib.sha1(_CAP_SOURCE + np.array(geometry).tobytes() + alphas.tobytes()
+                           + layer_key(medium, mf, mi, layer)).digest() if enabled else b""
         if key not in tables:
             tables[key] = len(tables)
-            values = layer_cap_moments(medium, mf, mi, layer, (beta, mu_w, beta_w, mu_a),
-                                       alphas) if enabled else [np.zeros(len(alphas))] * 4
-            for name, v in zip(moments, values):
-                moments[name].append(v)
+            moments.append(layer_cap_moments(medium, mf, mi, layer, caps, key) if enabled
+                           else np.zeros((4, len(alphas), n_wl)))
         table_of_layer.append(tables[key])
     step = 1e-6
     h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
@@ -152,8 +174,12 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
         cos_water=math.cos(beta), mu_a=mu_a, omega_a=cap_solid_angle,
         cos_air=math.cos(beta), h=float(h[1]), dh=float((h[2] - h[0]) / (2.0 * step)),
         dirs=f.add(dirs), air_factor=f.add(air_factor),
-        **{f"cap_{name}": f.add(np.array(v)) for name, v in moments.items()},
-        # transmission along mu_w from each level to the one above it (the first: unused)
-        level_decay=f.add(np.exp(-np.diff(level_tau, prepend=level_tau[:1]) / mu_w)),
+        # table-major, then alpha, then wavelength: a packet reads a row of n_wl
+        **{f"cap_{name}": f.add(np.array([t[m] for t in moments]))
+           for m, name in enumerate(("m0w", "m1w", "m0a", "m1a"))},
+        # transmission along mu_w from each level to the one above it (the first: unused),
+        # per wavelength (n_wl x n_depths)
+        level_decay=f.add(np.exp(-np.diff(level_tau, axis=1, prepend=level_tau[:, :1])
+                                 / mu_w)),
         in_water=i.add(in_water), table_of_layer=i.add(table_of_layer))
     return rec, f.array(), i.array()

@@ -106,8 +106,10 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
     layout = {}
-    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength)
-    size = spectral_size = 4 * n_wl + 1 if n_wl > 1 else 0
+    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength), then
+    # the local estimates' scratch (weight, tau, phase per wavelength)
+    scratch = 4 * n_wl + 1 if n_wl > 1 else 0
+    size = spectral_size = scratch + 3 * n_wl
     for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
                          ("local", (n_depths + 1) * n_dirs), ("cap", n_depths + 1),
                          ("budget", n_budget)):
@@ -119,7 +121,8 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
-        GRID, n_wl=n_wl, wl_stride=wl_stride, spectral=0, source_q=f.add(source_q),
+        GRID, n_wl=n_wl, wl_stride=wl_stride, spectral=0, scratch=scratch,
+        source_q=f.add(source_q),
         bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
         mu_cut=float(config.tallies.grazing_mu_cut), radiance_on=int(radiance_on),

@@ -23,7 +23,7 @@ class Column:
     """What the other packers need to know of the water column."""
     surface_level: int         # the tally level at 0- (or -1)
     depths: np.ndarray         # tally depths, snapped onto layer boundaries
-    level_tau: np.ndarray      # optical depth of each tally depth
+    level_tau: np.ndarray      # optical depth of each tally depth (n_wl, n_depths)
     albedo: np.ndarray         # per layer
     layers: tuple              # optics.LayerIOPs of each layer (a depth profile is resolved
     #                            into several layers of one configured layer)
@@ -109,10 +109,6 @@ def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) ->
         if value != off:
             raise cfg.ConfigError(f"{key} = {value!r} with {len(config.wavelengths)} wavelengths: "
                                   f"the spectral walk needs {key} = {off!r}")
-    if config.tallies.local_directions_deg or config.tallies.nadir_estimator == "local":
-        raise cfg.ConfigError("tallies.local_directions_deg / nadir_estimator = 'local' with "
-                              "several wavelengths: local estimates are monochromatic in this "
-                              "build; use nadir_estimator: crossing (auto does) and the quads")
     for layer in layers:
         scatters = layer.b > 0.0
         if scatters.any() and not scatters.all():
@@ -164,8 +160,8 @@ def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[
 
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
     """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
-    values per layer; the Column's optical depths and albedo are those of the first wavelength (the
-    local estimates, which only monochromatic scenes use, read them)."""
+    values per layer; optical depths wavelength-major (the local estimates read them); the
+    Column's albedo is the first wavelength's."""
     layers = optics.column_iops(config)
     n_wl = len(config.wavelengths)
     if n_wl > 1:
@@ -230,9 +226,9 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     layer_c = np.array([layer.c for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
     albedo_all = np.divide(layer_b, layer_c, out=np.zeros_like(layer_c), where=layer_b > 0.0)
     albedo = albedo_all[:, 0]
-    plane_tau = optical_depths(plane_z, segment_layer, layer_c[:, 0])
-    level_tau = np.array([plane_tau[np.searchsorted(plane_z, d)] for d in depths],
-                         dtype=np.float64)
+    plane_tau = np.array([optical_depths(plane_z, segment_layer, layer_c[:, j])
+                          for j in range(n_wl)])                             # (n_wl, n_planes)
+    level_tau = plane_tau[:, np.searchsorted(plane_z, depths)]              # (n_wl, n_depths)
     fraction = upward_fractions(config.estimator, albedo)
     cone = math.radians(config.estimator.upward_cone_deg)
     up_cos = math.cos(cone)

@@ -29,11 +29,12 @@ def pack(surface: cfg.Surface, n_water: float) -> np.ndarray:
 REFLECTED_SAMPLES = 4000
 
 
-def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray) -> np.ndarray | None:
-    """The sky's radiance (sun excluded) arriving in directions of travel dirs (downward), for
-    the analytic skies: uniform E_sky / pi; cardioidal (overcast) E_sky 3 (1 + 2 cos) / (7 pi)
-    (normalised so that integral L cos = E_sky). None for tabulated skies."""
-    e_sky = ill.Ed0 * ill.diffuse_fraction
+def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0
+                 ) -> np.ndarray | None:
+    """The radiance (sun excluded) of a sky of irradiance e_sky arriving in directions of
+    travel dirs (downward), for the analytic skies: uniform E_sky / pi; cardioidal (overcast)
+    E_sky 3 (1 + 2 cos) / (7 pi) (normalised so that integral L cos = E_sky). None for
+    tabulated skies."""
     if ill.sky == "uniform":
         return np.full(len(dirs), e_sky / math.pi)
     if ill.sky in ("cardioidal", "overcast"):
@@ -54,20 +55,21 @@ def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray) -> np.ndarray | None:
 
 def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: int,
                     batches: int) -> np.ndarray | None:
-    """(batches, directions, 2): per batch, the surface-reflected sky and sun radiance in each
-    exact air direction of local_directions_deg (upward ones), and the sky radiance L_sky in
-    the direction a flat surface reflects into it (rho's denominator, DESIGN 7.3); None when
-    the sky is tabulated or no direction is upward. The sky part is a Monte Carlo average over
-    REFLECTED_SAMPLES surface samples per batch (own streams from (seed, batch, 1)); the sun's
-    part is the single-reflection glint (cox_munk.glint_single, exact up to the light the sun
-    sends by two facets or more), 0 for a delta surface."""
+    """(batches, directions, 3): per batch, in each exact air direction of
+    local_directions_deg (upward ones), the surface-reflected radiance of a sky of unit
+    irradiance, that of a sun of unit direct irradiance Ed0 (1 - f), and the unit sky's
+    radiance L_sky in the direction a flat surface reflects into it (rho's denominator, DESIGN
+    7.3); reflected_at scales them to a wavelength's light. None when the sky is tabulated or
+    no direction is upward. The sky part is a Monte Carlo average over REFLECTED_SAMPLES
+    surface samples per batch (own streams from (seed, batch, 1)); the sun's part is the
+    single-reflection glint (cox_munk.glint_single, exact up to the light the sun sends by two
+    facets or more), 0 for a delta surface."""
     from ..kernel.surface import cox_munk
     from ..kernel.surface.dispatch import reflected_from
     ill = config.illumination
-    out = np.zeros((batches, len(config.tallies.local_directions_deg), 2))
+    out = np.zeros((batches, len(config.tallies.local_directions_deg), 3))
     theta_s = math.radians(ill.sun_zenith_deg)
     sun = (math.sin(theta_s), 0.0, math.cos(theta_s))
-    e_sun = ill.Ed0 * (1.0 - ill.diffuse_fraction) / max(math.cos(theta_s), 1e-12)
     for k, (theta_deg, phi_deg) in enumerate(config.tallies.local_directions_deg):
         t, p = math.radians(theta_deg), math.radians(phi_deg)
         o = (math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t))
@@ -78,7 +80,8 @@ def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: i
         l_sky_mirror = sky_radiance(ill, mirror)
         if l_sky_mirror is None:
             return None
-        glint = 0.0 if surface["delta"] else e_sun * cox_munk.glint_single(surface, *sun, *o)
+        glint = 0.0 if surface["delta"] else cox_munk.glint_single(surface, *sun, *o) / max(
+            math.cos(theta_s), 1e-12)
         for b in range(batches):
             state = np.random.SeedSequence(config.seed, spawn_key=(first_batch + b, 1)
                                            ).generate_state(4, np.uint64)
@@ -87,5 +90,14 @@ def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: i
             sky = np.zeros(REFLECTED_SAMPLES)
             if hit.any():
                 sky[hit] = sky_radiance(ill, came[hit])
-            out[b, k] = sky.mean() + glint, l_sky_mirror[0]
+            out[b, k] = sky.mean(), glint, l_sky_mirror[0]
     return out
+
+
+def reflected_at(unit: np.ndarray, ed0: float, diffuse_fraction: float) -> np.ndarray:
+    """(batches, directions, 2): reflected_local's unit radiances for a wavelength's light
+    (Ed0 at 0+, its diffuse fraction f): the reflected sky and sun radiance, and L_sky."""
+    e_sky = ed0 * diffuse_fraction
+    e_sun = ed0 * (1.0 - diffuse_fraction)
+    return np.stack([unit[..., 0] * e_sky + unit[..., 1] * e_sun, unit[..., 2] * e_sky],
+                    axis=-1)

@@ -100,19 +100,22 @@ def evaluate(medium, mf, mi, layer, cos_psi):
 
 
 @setup
-def layer_density(medium, mf, mi, layer, angles):
-    """q(psi) = 2 pi p(psi) sin(psi) of the layer's phase function at each angle (rad), for
-    tables built once per scene; tabulated components are read exactly, without the loss of
-    precision of cos(psi) near 0."""
+def layer_density(medium, mf, mi, layer, wavelength, angles):
+    """q(psi) = 2 pi p(psi) sin(psi) of the layer's phase function at wavelength index
+    `wavelength`, at each angle (rad), for tables built once per scene; tabulated components
+    are read exactly, without the loss of precision of cos(psi) near 0."""
     out = np.empty(angles.shape[0])
     first = mi[medium.comp_start + layer]
+    cumweight = medium.comp_cumweight + wavelength * medium.n_comps
     for i in range(angles.shape[0]):
         angle = angles[i]
         total = 0.0
         previous = 0.0
         for k in range(first, first + mi[medium.comp_count + layer]):
-            weight = mf[medium.comp_cumweight + k] - previous
-            previous = mf[medium.comp_cumweight + k]
+            weight = mf[cumweight + k] - previous
+            previous = mf[cumweight + k]
+            if weight == 0.0:
+                continue
             if mi[medium.comp_model + k] == PHASE_TABULATED:
                 psi_at, q_at, _, length = table_at(medium, mi, k)
                 total += weight * tabulated.density(mf, psi_at, q_at, length, angle)
