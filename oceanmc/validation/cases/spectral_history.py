@@ -32,7 +32,9 @@ SCENES = (
 # crossing estimate of the 5-degree nadir cap is the noisiest
 QUANTITIES = (("Ed", "Ed", True, (0.05, 0.2)), ("Eu", "Eu", True, (0.05, 0.2)),
               ("Eo", "Eo", True, (0.05, 0.2)), ("air/Eu", "Eu(0+)", False, (0.05, 0.2)),
-              ("air/Rrs_nadir", "Rrs nadir (crossing)", False, (0.1, 0.35)),
+              ("Lu", "Lu (local estimate of the nadir cap)", True, (0.05, 0.2)),
+              ("air/Rrs_nadir", "Rrs nadir (local estimate)", False, (0.05, 0.2)),
+              ("air/Rrs_nadir_crossing", "Rrs nadir (crossing)", False, (0.1, 0.35)),
               ("budget/water_leaving", "budget water_leaving", False, (0.05, 0.2)))
 
 
@@ -41,7 +43,7 @@ def spectral_config(name: str, photons: int, layers: list, bottom: dict, depths:
     config = scene(name, photons, layers=layers, bottom=bottom, sun=30.0, diffuse=0.2,
                    depths=depths)
     config["wavelengths_nm"] = list(wavelengths)
-    config["tallies"]["nadir_estimator"] = "crossing"   # the estimator both runs share
+    config["tallies"]["nadir_estimator"] = "local"   # and its crossing estimate beside it
     return config
 
 
@@ -89,16 +91,17 @@ def case_spectral_history(ctx: Ctx) -> None:
         ax.set_ylabel("Rrs nadir (1/sr)")
         ax.legend(fontsize=7)
     fig.tight_layout()
-    ctx.figure(fig, "rrs", "Rrs at nadir (crossing estimate) of each scene: all wavelengths in "
+    ctx.figure(fig, "rrs", "Rrs at nadir (local estimate) of each scene: all wavelengths in "
                "one photon history (circles) against an independent run per wavelength "
                "(squares, shifted 3 nm).")
     ctx.note("Each scene is run once with all five wavelengths in one photon history (hero "
              "wavelength per photon, spectral multiple importance sampling with the balance "
              "heuristic; every wavelength's weight at most n_wl = 5 times what its own walk "
              "carries) and once per wavelength on its own (wavelengths_nm with one entry: the "
-             "monochromatic walk), with other seeds. Compared: Ed, Eu, Eo at every depth, Eu(0+), "
-             "Rrs nadir (crossing estimate in both) and the water-leaving fraction at every "
-             "wavelength, z against both standard errors (Bonferroni bound per group); energy "
+             "monochromatic walk), with other seeds. Compared: Ed, Eu, Eo and Lu (local estimate "
+             "of the nadir cap: each wavelength's weight, phase function and optical depths from "
+             "the same collisions) at every depth, Eu(0+), Rrs nadir (local and crossing "
+             "estimates in both) and the water-leaving fraction at every wavelength, z against both standard errors (Bonferroni bound per group); energy "
              "closure: the budget adds up to 1 at every wavelength.")
 
 
