@@ -73,17 +73,18 @@ def layer_phase(medium, mf, mi, grid, layer, cos_psi, out):
 def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu, j):
     """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
     t/n^2; 0 if it is not scored there), at wavelength index j."""
-    n_dirs = est.n_dirs
-    local = grid.local + j * grid.wl_stride
+    n = grid.n_wl
+    row = est.n_dirs * n     # one level's scores: direction-major, wavelength fastest
+    local = grid.local + k * n + j
     taus = grid.level_tau + j * grid.n_depths
     if ei[est.in_water + k]:
         for level in range(grid.n_depths):
             if gf[grid.level_z + level] <= z:
-                tally[local + level * n_dirs + k] += base * math.exp(
+                tally[local + level * row] += base * math.exp(
                     -(tau_here - gf[taus + level]) / mu)
     factor = ef[est.air_factor + k]
     if factor > 0.0:
-        tally[local + grid.n_depths * n_dirs + k] += base * math.exp(-tau_here / mu) * factor
+        tally[local + grid.n_depths * row] += base * math.exp(-tau_here / mu) * factor
 
 
 @internal
@@ -140,7 +141,8 @@ def cap_from_collision(est, ef, grid, gf, tally, z, tau_here, w_scattered, m0w, 
     deepest one above is one exp, and each level up multiplies it by the transmission between
     the two levels (level_decay), so the cap costs two exps (water and air) whatever the
     number of levels."""
-    block = j * grid.wl_stride
+    n = grid.n_wl
+    cap = grid.cap + j     # level l of wavelength j at cap + l n
     taus = grid.level_tau + j * grid.n_depths
     mu = est.mu_w
     above = 0
@@ -152,12 +154,12 @@ def cap_from_collision(est, ef, grid, gf, tally, z, tau_here, w_scattered, m0w, 
         scale = w_scattered / (mu * est.omega_w)
         for level in range(above - 1, -1, -1):
             dtau = tau_here - gf[taus + level]
-            tally[grid.cap + block + level] += scale * transmitted * (
+            tally[cap + level * n] += scale * transmitted * (
                 m0w + m1w * (dtau / mu - 1.0) / mu)
             transmitted *= ef[decay + level]
     mu = est.mu_a
     e = math.exp(-tau_here / mu)
-    tally[grid.cap + block + grid.n_depths] += w_scattered * e * (
+    tally[cap + grid.n_depths * n] += w_scattered * e * (
         m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a
 
 
@@ -185,9 +187,9 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer
                 if t > 0.0 and iz < 0.0:
                     layer_phase(medium, mf, mi, grid, layer, ux * ix + uy * iy + uz * iz,
                                 phase_j)
-                    at = grid.local + grid.n_depths * est.n_dirs + k
+                    at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
-                        tally[at + j * grid.wl_stride] += (
+                        tally[at + j] += (
                             weight[j] * phase_j[j] * t * math.exp(tau[j] / iz) / -iz * factor)
                 continue
             dx, dy, dz = direction(est, ef, k)
@@ -232,9 +234,9 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, 
                 ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
                 if t > 0.0 and iz < 0.0:
                     f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz)
-                    at = grid.local + grid.n_depths * est.n_dirs + k
+                    at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
-                        tally[at + j * grid.wl_stride] += (
+                        tally[at + j] += (
                             weight[j] * f * t * math.exp(tau[j] / iz) * factor)
                 continue
             dx, dy, dz = direction(est, ef, k)
@@ -246,11 +248,10 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, 
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, oz)
         for j in range(n):
-            block = grid.cap + j * grid.wl_stride
             taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
                 if gf[grid.level_z + level] <= z:
-                    tally[block + level] += weight[j] * f * math.exp(
+                    tally[grid.cap + level * n + j] += weight[j] * f * math.exp(
                         -(tau[j] - gf[taus + level]) / mu)
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
@@ -261,5 +262,5 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, 
         f = brdf.evaluate_local(model, bp, -ux, uy, uz, sin_w * math.cos(phi),
                                 -sin_w * math.sin(phi), mu_w)
         for j in range(n):
-            tally[grid.cap + j * grid.wl_stride + grid.n_depths] += (
+            tally[grid.cap + grid.n_depths * n + j] += (
                 weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

@@ -86,11 +86,11 @@ SKY = _record(
 #               spectral scenes: source_q (2 x n_wl: sun, sky), bottom_q (n_wl)
 #   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: K, G,
 #               F (n_wl each), D, beta (n_wl)); every scene: the local estimates' scratch
-#               (kernel/local_estimate.py: weight, tau, phase (n_wl each)); then one block of
-#               wl_stride
-#               per wavelength: flux (n_levels x 4), radiance (n_levels x n_theta_cols x
-#               n_phi_cols), local (n_depths + 1) x n_dirs, cap (n_depths + 1), budget
-#               (n_budget); the offsets below are those of the first block
+#               (kernel/local_estimate.py: weight, tau, phase (n_wl each)), and their scores,
+#               local ((n_depths + 1) x n_dirs x n_wl) and cap ((n_depths + 1) x n_wl); then
+#               one block of wl_stride per wavelength: flux (n_levels x 4), radiance (n_levels
+#               x n_theta_cols x n_phi_cols), budget (n_budget); the offsets below are those of
+#               the first block
 GRID = _record(
     "n_wl", "wl_stride", "spectral", "scratch", "source_q", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",

@@ -105,18 +105,21 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
     n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
-    layout = {}
-    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength), then
-    # the local estimates' scratch (weight, tau, phase per wavelength)
+    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength), the
+    # local estimates' scratch (weight, tau, phase per wavelength), then their scores with the
+    # wavelength fastest (a collision scores every wavelength at the same level: one stretch
+    # of memory, not one block per wavelength)
     scratch = 4 * n_wl + 1 if n_wl > 1 else 0
-    size = spectral_size = scratch + 3 * n_wl
+    local = scratch + 3 * n_wl
+    cap = local + (n_depths + 1) * n_dirs * n_wl
+    size = shared_size = cap + (n_depths + 1) * n_wl
+    layout = {"local": local, "cap": cap}
     for name, length in (("flux", 4 * n_levels), ("radiance", n_levels * theta_cols * phi_cols),
-                         ("local", (n_depths + 1) * n_dirs), ("cap", n_depths + 1),
                          ("budget", n_budget)):
         layout[name] = size
         size += length
-    wl_stride = size - spectral_size
-    size = spectral_size + n_wl * wl_stride
+    wl_stride = size - shared_size
+    size = shared_size + n_wl * wl_stride
     _, diffuse, _ = optics.illumination_spectrum(config)
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
@@ -150,10 +153,17 @@ def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
         at = int(g[name]) + block
         return tallies[:, at:at + length].reshape((nb,) + shape)
 
+    def side_by_side(name, shape):
+        """A score array with every wavelength's values side by side (wavelength fastest)."""
+        n_wl = int(g["n_wl"])
+        at = int(g[name])
+        length = int(np.prod(shape)) * n_wl
+        return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))[..., wavelength]
+
     n_dirs = int(g["n_dirs"])
     rad = (n_levels, int(g["theta_cols"]), int(g["phi_cols"]))
     return {"flux": part("flux", 4 * n_levels, (n_levels, 4)),
             "radiance": part("radiance", int(np.prod(rad)), rad),
-            "local": part("local", (n_levels - 1) * n_dirs, (n_levels - 1, n_dirs)),
-            "cap": part("cap", n_levels - 1, (n_levels - 1,)),
+            "local": side_by_side("local", (n_levels - 1, n_dirs)),
+            "cap": side_by_side("cap", (n_levels - 1,)),
             "budget": part("budget", int(g["n_budget"]), (int(g["n_budget"]),))}
