@@ -5,8 +5,9 @@ history (kernel/spectral.py) and once as 31 independent single-wavelength runs. 
 figure of merit FOM = 1 / (rel_err^2 time) of each way of getting the whole spectrum: the one
 run's time, or the sum of the 31 runs' times (what the spectrum costs either way), with the
 relative standard error of that band's Rrs at nadir (the local estimate of the nadir cap in
-both, and the crossing estimate of the same runs) and of its water-leaving fraction. Writes DIR/spectral.md and
-DIR/spectral.json (`oceanmc bench --spectral`), and the full benchmark includes the section."""
+both, and the crossing estimate of the same runs) and of its water-leaving fraction. Writes
+DIR/spectral.md and DIR/spectral.json (`oceanmc bench --spectral`), and the full benchmark
+includes the section."""
 from __future__ import annotations
 
 import json

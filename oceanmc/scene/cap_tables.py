@@ -68,8 +68,8 @@ def cap_geometry(beta: float, mu_bar: float, alphas: np.ndarray) -> tuple:
     """What cap_moments needs of a cap of half-angle beta (mean cosine mu_bar) at each alpha,
     whatever the phase function: the angles of the circles wholly inside it, the quadrature
     angles psi of the others, and per interval between them the share of its circle inside the
-    cap (phi0 / pi) and that arc's mean cosine to the axis times the share. Built once for all the phase
-    functions of a scene (the trigonometry costs ten times one table's interpolation)."""
+    cap (phi0 / pi) and that arc's mean cosine to the axis times the share. Built once for all
+    the phase functions of a scene (the trigonometry costs ten times one table's interpolation)."""
     alpha = alphas[:, None]
     inside = np.clip(beta - alphas, 0.0, None)
     lo = np.abs(alphas - beta)[:, None]

@@ -101,7 +101,8 @@ def case_spectral_history(ctx: Ctx) -> None:
              "monochromatic walk), with other seeds. Compared: Ed, Eu, Eo and Lu (local estimate "
              "of the nadir cap: each wavelength's weight, phase function and optical depths from "
              "the same collisions) at every depth, Eu(0+), Rrs nadir (local and crossing "
-             "estimates in both) and the water-leaving fraction at every wavelength, z against both standard errors (Bonferroni bound per group); energy "
+             "estimates in both) and the water-leaving fraction at every wavelength, z against "
+             "both standard errors (Bonferroni bound per group); energy "
              "closure: the budget adds up to 1 at every wavelength.")
 
 
