@@ -133,10 +133,19 @@ def into_water_through_rough(surface, est, ef, k, rng):
 
 
 @internal
-def cap_from_collision(est, ef, grid, gf, tally, z, tau_here, w_scattered, m0w, m1w, m0a, m1a,
-                       j):
-    """The polar-cap average of the nadir-viewing radiance that a collision at depth z sends
-    to every level above it and to 0+, at wavelength index j (see scene/estimates.py for the
+def levels_above(grid, gf, z):
+    """How many tally levels lie at or above depth z (they are sorted by depth)."""
+    above = 0
+    while above < grid.n_depths and gf[grid.level_z + above] <= z:
+        above += 1
+    return above
+
+
+@internal
+def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m0w, m1w, m0a,
+                       m1a, j):
+    """The polar-cap average of the nadir-viewing radiance that a collision sends to the
+    `above` levels above it (levels_above) and to 0+, at wavelength index j (see scene/estimates.py for the
     expansion and its accuracy). The levels are sorted by depth: the transmission to the
     deepest one above is one exp, and each level up multiplies it by the transmission between
     the two levels (level_decay), so the cap costs two exps (water and air) whatever the
@@ -145,9 +154,6 @@ def cap_from_collision(est, ef, grid, gf, tally, z, tau_here, w_scattered, m0w, 
     cap = grid.cap + j     # level l of wavelength j at cap + l n
     taus = grid.level_tau + j * grid.n_depths
     mu = est.mu_w
-    above = 0
-    while above < grid.n_depths and gf[grid.level_z + above] <= z:
-        above += 1
     if above > 0:
         decay = est.level_decay + j * grid.n_depths
         transmitted = math.exp(-(tau_here - gf[taus + above - 1]) / mu)
@@ -201,10 +207,11 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer
     if est.cap_on:
         i, f = cap_node(est, -uz)
         table = ei[est.table_of_layer + layer]
+        above = levels_above(grid, gf, z)
         for j in range(n):
             m0w, m1w, m0a, m1a = cap_lookup(est, ef, table, i, f, n, j)
-            cap_from_collision(est, ef, grid, gf, tally, z, tau[j], weight[j], m0w, m1w, m0a,
-                               m1a, j)
+            cap_from_collision(est, ef, grid, gf, tally, above, tau[j], weight[j], m0w, m1w,
+                               m0a, m1a, j)
 
 
 @internal

@@ -208,26 +208,31 @@ def phase_values(medium, mf, mi, layer, cos_psi, out):
 
 @internal
 def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
-    """What a collision of the packet sends at each wavelength, as a local estimate needs it:
-    the packet settles (p.w G_j = F_j, mean K = 1), then adding the collision point to the path
-    gives wavelength j the factor b_j (its scattering) and each density K_k the factor c_k (its
-    collision density), so weight_j = p.w G_j b_j / mean_k(K_k c_k) (one wavelength: w b / c,
-    the implicit-capture weight); tau_j: the optical depth at the packet."""
-    settle(medium, mf, grid, tally, p, layer)
+    """What a collision of the packet sends at each wavelength, as a local estimate needs it,
+    without settling: with e_j = exp(-(c_j - c_h) D) the deferred factors, a settle would make
+    F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w took of the
+    reference's), and adding the collision point to the path gives wavelength j the factor b_j
+    (its scattering) and each K_k the factor c_k (its collision density), so weight_j = p.w s
+    G_j e_j b_j / mean_k(K_k e_k c_k) (the mean of K e cancels; one wavelength: w b / c, the
+    implicit-capture weight). tau_j: the optical depth at the packet."""
     n = grid.n_wl
     k, g, _ = weights(grid, tally)
     row = medium.layer_c + layer * n
     c = mf[row:row + n]
     albedo = mf[medium.layer_albedo + layer * n:medium.layer_albedo + layer * n + n]
+    dist = tally[grid.spectral + 3 * n]
+    c_h = c[p.wavelength]
+    for j in range(n):
+        weight[j] = math.exp(-(c[j] - c_h) * dist)
     total = 0.0
     for j in range(n):
-        total += k[j] * c[j]
-    scale = p.w * n / total
+        total += k[j] * weight[j] * c[j]
+    scale = p.w * math.exp((c[p.reference] - c_h) * dist) * n / total
     seg = p.seg
     dz = p.z - mf[medium.plane_z + seg]
     taus = medium.plane_tau + seg
     for j in range(n):
-        weight[j] = scale * g[j] * albedo[j] * c[j]
+        weight[j] *= scale * g[j] * albedo[j] * c[j]
         tau[j] = mf[taus + j * medium.n_planes] + c[j] * dz
 
 
