@@ -4,8 +4,8 @@ Lambertian bottom of reflectance 0.3 at 5 m, traced once with all wavelengths in
 history (kernel/spectral.py) and once as 31 independent single-wavelength runs. Per band, the
 figure of merit FOM = 1 / (rel_err^2 time) of each way of getting the whole spectrum: the one
 run's time, or the sum of the 31 runs' times (what the spectrum costs either way), with the
-relative standard error of that band's Rrs at nadir (the local estimate of the nadir cap in
-both, and the crossing estimate of the same runs) and of its water-leaving fraction. Writes
+relative standard error of that band's Rrs at nadir (the crossing estimate in both: auto's
+choice for spectral scenes, config/scene.py nadir_local) and of its water-leaving fraction. Writes
 DIR/spectral.md and DIR/spectral.json (`oceanmc bench --spectral`), and the full benchmark
 includes the section."""
 from __future__ import annotations
@@ -22,8 +22,9 @@ WAVELENGTHS = {"start": 400.0, "stop": 700.0, "step": 10.0}
 CHLOROPHYLL = (0.1, 1.0, 10.0)
 BOTTOM_DEPTH_M = 5.0
 BOTTOM_REFLECTANCE = 0.3
-QUANTITIES = (("air/Rrs_nadir", "Rrs nadir (local)"),
-              ("air/Rrs_nadir_crossing", "Rrs nadir (crossing)"),
+# (a run with the local estimate has both Rrs nadir estimates: the local one as air/Rrs_nadir)
+QUANTITIES = (("air/Rrs_nadir_crossing", "Rrs nadir (crossing)"),
+              ("air/Rrs_nadir", "Rrs nadir"),
               ("budget/water_leaving", "water-leaving fraction"))
 TARGET = 10.0
 # the FOM ratio of a band rests on two variance estimates from BATCHES batch means each, each
@@ -43,7 +44,7 @@ def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int) -> dic
             {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": chl}]}]},
         "bottom": {"model": "lambertian", "reflectance": BOTTOM_REFLECTANCE} if bottom
         else {"model": "none"},
-        "tallies": {"depths_m": [0.0], "nadir_estimator": "local"},
+        "tallies": {"depths_m": [0.0]},   # auto: the crossing estimate for both
     }
 
 
@@ -103,9 +104,9 @@ def report_lines(data: dict) -> list[str]:
              f"against 31 independent runs of {data['single_photons']:,} photons, "
              f"{data['threads']} threads, {BATCHES} batches each. FOM = 1 / (rel_err^2 time) per "
              "band, time = what the whole spectrum costs (the one run; the sum of the 31). "
-             "rel_err: the batch standard error over the value (Rrs at nadir by the local "
-             "estimate of the nadir cap in both, and by the crossing estimate of the same runs; "
-             f"the FOM ratio itself is uncertain by about 18% per band, from "
+             "rel_err: the batch standard error over the value (Rrs at nadir by the crossing "
+             "estimate in both, the spectral default; the FOM ratio itself is uncertain by "
+             f"about 18% per band, from "
              f"the standard errors of {BATCHES} batches). "
              f"Target: FOM ratio >= {TARGET:g} in every band. The FOM ratio is the product of "
              "two factors, given for the worst band: the time ratio (the 31 runs' total time over "

@@ -109,10 +109,14 @@ class SceneConfig(_Strict):
     @property
     def nadir_local(self) -> bool:
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator (auto: unless
-        the bottom is a mirror or the sea rough)."""
+        the bottom is a mirror, the sea rough, or the scene spectral: the one-history walk's
+        local estimate scores every wavelength at every collision, which costs it 4 to 7 times
+        the crossing walk's time per photon for 3 to 15 times less variance, a figure of merit
+        below the crossing estimate's over a bottom; benchmarks/README.md)."""
         mode = self.tallies.nadir_estimator
         return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom)
-                                   and self.surface.model != "cox_munk")
+                                   and self.surface.model != "cox_munk"
+                                   and len(self.wavelengths) == 1)
 
     @property
     def wavelengths(self):

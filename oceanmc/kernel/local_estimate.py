@@ -29,7 +29,7 @@ import math
 
 from . import spectral
 from .brdf import dispatch as brdf
-from .compile import internal
+from .compile import internal, kernel
 from .geometry import from_angles
 from .phase import dispatch as phase
 from .rng import uniform
@@ -60,9 +60,11 @@ def direction(est, ef, k):
     return ef[at], ef[at + 1], ef[at + 2]
 
 
-@internal
+@kernel
 def layer_phase(medium, mf, mi, grid, layer, cos_psi, out):
-    """The layer's phase function p_j(cos_psi) in 1/sr at every wavelength into out."""
+    """The layer's phase function p_j(cos_psi) in 1/sr at every wavelength into out (called,
+    not inlined: its two call sites, exact directions through the flat and the rough surface,
+    would otherwise each carry a copy of the spectral terms' reading into the collision)."""
     if grid.n_wl == 1:
         out[0] = phase.evaluate(medium, mf, mi, layer, cos_psi)
     else:
@@ -88,23 +90,9 @@ def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu, j):
 
 
 @internal
-def cap_node(est, cos_alpha):
-    """(i, f): the node of the cap tables' alpha grid below the angle acos(cos_alpha) between
-    a packet's direction and straight up, and the fraction of the way to the next; the grid is
-    uniform on two pieces."""
-    alpha = math.acos(min(1.0, max(-1.0, cos_alpha)))
-    if alpha < est.fine_end:
-        x = alpha / est.fine_step
-    else:
-        x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
-    i = min(int(x), est.n_alpha - 2)
-    return i, x - i
-
-
-@internal
 def cap_lookup(est, ef, table, i, f, n_wl, j):
     """(M0, M1) of the water cap and of the air cap's water side at wavelength index j of
-    table `table`, linear in alpha between nodes i and i + 1 (cap_node)."""
+    table `table`, linear in alpha between nodes i and i + 1 and the fraction f of the way."""
     g = 1.0 - f
     at = (table * est.n_alpha + i) * n_wl + j
     up = at + n_wl
@@ -133,19 +121,10 @@ def into_water_through_rough(surface, est, ef, k, rng):
 
 
 @internal
-def levels_above(grid, gf, z):
-    """How many tally levels lie at or above depth z (they are sorted by depth)."""
-    above = 0
-    while above < grid.n_depths and gf[grid.level_z + above] <= z:
-        above += 1
-    return above
-
-
-@internal
 def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m0w, m1w, m0a,
                        m1a, j):
     """The polar-cap average of the nadir-viewing radiance that a collision sends to the
-    `above` levels above it (levels_above) and to 0+, at wavelength index j (see scene/estimates.py for the
+    `above` levels above it and to 0+, at wavelength index j (see scene/estimates.py for the
     expansion and its accuracy). The levels are sorted by depth: the transmission to the
     deepest one above is one exp, and each level up multiplies it by the transmission between
     the two levels (level_decay), so the cap costs two exps (water and air) whatever the
@@ -205,9 +184,19 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer
                 add_to_levels(est, ef, ei, grid, gf, tally, z, tau[j], k,
                               weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
-        i, f = cap_node(est, -uz)
+        # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
+        # between the packet's direction and straight up, and the fraction to the next
+        alpha = math.acos(min(1.0, max(-1.0, -uz)))
+        if alpha < est.fine_end:
+            x = alpha / est.fine_step
+        else:
+            x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
+        i = min(int(x), est.n_alpha - 2)
+        f = x - i
         table = ei[est.table_of_layer + layer]
-        above = levels_above(grid, gf, z)
+        above = 0   # the tally levels at or above the collision (sorted by depth)
+        while above < grid.n_depths and gf[grid.level_z + above] <= z:
+            above += 1
         for j in range(n):
             m0w, m1w, m0a, m1a = cap_lookup(est, ef, table, i, f, n, j)
             cap_from_collision(est, ef, grid, gf, tally, above, tau[j], weight[j], m0w, m1w,

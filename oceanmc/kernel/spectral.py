@@ -206,7 +206,7 @@ def phase_values(medium, mf, mi, layer, cos_psi, out):
         out[j] *= per_angle * c_over_b[j] * inv_c[j]
 
 
-@internal
+@kernel
 def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
     """What a collision of the packet sends at each wavelength, as a local estimate needs it,
     without settling: with e_j = exp(-(c_j - c_h) D) the deferred factors, a settle would make
@@ -236,7 +236,7 @@ def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
         tau[j] = mf[taus + j * medium.n_planes] + c[j] * dz
 
 
-@internal
+@kernel
 def bottom_weights(medium, mf, grid, gf, tally, p, weight, tau):
     """What a bottom reflection sends at each wavelength, as a local estimate needs it (the
     packet settled on reaching the bottom plane): weight_j = p.w G_j bottom_q_j, times the
