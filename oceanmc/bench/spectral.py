@@ -44,7 +44,9 @@ def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int) -> dic
             {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": chl}]}]},
         "bottom": {"model": "lambertian", "reflectance": BOTTOM_REFLECTANCE} if bottom
         else {"model": "none"},
-        "tallies": {"depths_m": [0.0]},   # auto: the crossing estimate for both
+        # the crossing estimate in both (auto's choice for the spectral scene, not for the
+        # single-wavelength ones)
+        "tallies": {"depths_m": [0.0], "nadir_estimator": "crossing"},
     }
 
 
@@ -82,6 +84,8 @@ def measure(quick: bool, say, threads: int = 2) -> dict:
             row = {"name": config["name"], "wavelengths": wavelengths,
                    "time_one_history_s": t_spectral, "time_31_runs_s": t_singles}
             for name, _ in QUANTITIES:
+                if name not in spectral:
+                    continue
                 rel_one = [_relative(spectral, name, k) for k in range(len(wavelengths))]
                 rel_single = [_relative(r, name) for r, _ in singles]
                 # a band no photon reached has rel_err inf, FOM 0
