@@ -158,10 +158,11 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer
     weight, tau, phase_j = scratch(grid, tally)
     if n == 1:
         weight[0] = w_scattered
-        tau[0] = optical_depth(medium, mf, p.seg, layer, p.z, 0)
     else:
-        spectral.collision_weights(medium, mf, grid, tally, p, layer, weight, tau)
+        spectral.collision_weights(medium, mf, grid, tally, p, layer, weight)
     z = p.z
+    for j in range(n):
+        tau[j] = optical_depth(medium, mf, p.seg, layer, z, j)
     ux, uy, uz = p.ux, p.uy, p.uz
     if est.directions_on:
         rough = surface.delta == 0
@@ -216,9 +217,10 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, 
     bottom_plane = medium.n_planes - 1
     if n == 1:
         weight[0] = p.w
-        tau[0] = mf[medium.plane_tau + bottom_plane]
     else:
-        spectral.bottom_weights(medium, mf, grid, gf, tally, p, weight, tau)
+        spectral.bottom_weights(grid, gf, tally, p, weight)
+    for j in range(n):
+        tau[j] = mf[medium.plane_tau + j * medium.n_planes + bottom_plane]
     z = mf[medium.plane_z + bottom_plane]
     ux, uy, uz = p.ux, p.uy, p.uz
     model = bottom.model

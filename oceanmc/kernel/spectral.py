@@ -207,14 +207,14 @@ def phase_values(medium, mf, mi, layer, cos_psi, out):
 
 
 @kernel
-def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
+def collision_weights(medium, mf, grid, tally, p, layer, weight):
     """What a collision of the packet sends at each wavelength, as a local estimate needs it,
     without settling: with e_j = exp(-(c_j - c_h) D) the deferred factors, a settle would make
     F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w took of the
     reference's), and adding the collision point to the path gives wavelength j the factor b_j
     (its scattering) and each K_k the factor c_k (its collision density), so weight_j = p.w s
     G_j e_j b_j / mean_k(K_k e_k c_k) (the mean of K e cancels; one wavelength: w b / c, the
-    implicit-capture weight). tau_j: the optical depth at the packet."""
+    implicit-capture weight)."""
     n = grid.n_wl
     k, g, _ = weights(grid, tally)
     row = medium.layer_c + layer * n
@@ -228,27 +228,21 @@ def collision_weights(medium, mf, grid, tally, p, layer, weight, tau):
     for j in range(n):
         total += k[j] * weight[j] * c[j]
     scale = p.w * math.exp((c[p.reference] - c_h) * dist) * n / total
-    seg = p.seg
-    dz = p.z - mf[medium.plane_z + seg]
-    taus = medium.plane_tau + seg
     for j in range(n):
         weight[j] *= scale * g[j] * albedo[j] * c[j]
-        tau[j] = mf[taus + j * medium.n_planes] + c[j] * dz
 
 
 @kernel
-def bottom_weights(medium, mf, grid, gf, tally, p, weight, tau):
+def bottom_weights(grid, gf, tally, p, weight):
     """What a bottom reflection sends at each wavelength, as a local estimate needs it (the
     packet settled on reaching the bottom plane): weight_j = p.w G_j bottom_q_j, times the
-    BRDF the estimate evaluates; tau_j: the bottom's optical depth."""
+    BRDF the estimate evaluates."""
     n = grid.n_wl
     _, g, _ = weights(grid, tally)
     share = gf[grid.bottom_q:grid.bottom_q + n]
-    taus = medium.plane_tau + medium.n_planes - 1
     w = p.w
     for j in range(n):
         weight[j] = w * g[j] * share[j]
-        tau[j] = mf[taus + j * medium.n_planes]
 
 
 @internal
