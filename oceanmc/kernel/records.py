@@ -37,8 +37,9 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 #   float pool: plane_z (n_planes), plane_tau (n_wl x n_planes); layer_c, layer_inv_c,
 #               layer_albedo, layer_c_over_b (n_layers x n_wl); up_fraction, up_density,
 #               up_keep (n_layers); comp_cumweight (n_wl x n_comps; cumulative within each
-#               layer), comp_params (2 each); tab_psi (each distinct angle grid once, at a component's psi_start),
-#               tab_q, tab_cdf (each table at its component's tab_start); mix_coef
+#               layer), comp_params (2 each); tab_psi (each distinct angle grid once, at a
+#               component's psi_start), tab_q, tab_cdf (each table at its component's
+#               tab_start); mix_coef
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); mix_ptr (n_layers + 1), mix_comp, mix_at: the terms
