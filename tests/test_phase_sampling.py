@@ -414,3 +414,33 @@ def test_evaluate_mixture_is_b_weighted():
     mu = np.linspace(-1.0, 1.0, 101)
     ref = 0.75 * hg_pdf(0.9, mu) + 0.25 * 3.0 / (16.0 * math.pi) * (1.0 + mu ** 2)
     np.testing.assert_allclose(_evaluate(sc, 0, mu), ref, rtol=1e-10)
+
+
+@pytest.mark.parametrize("shape", ["forward", "zero_beyond_1_rad", "few_nodes"])
+def test_guide_table_finds_the_interval_a_bisection_finds(shape):
+    """The sampler starts its search from a guide table (kernel/phase/tabulated.py); the interval
+    it finds must be the one with cdf[i] <= u < cdf[i + 1], for tables with flat stretches of
+    the CDF (q = 0) and tables with fewer nodes than cells of interest, and for u at the cells'
+    edges, where u * G rounds."""
+    from oceanmc.kernel.phase import tabulated
+    if shape == "few_nodes":
+        psi = np.radians([0.0, 1.0, 20.0, 90.0, 180.0])
+        q = np.array([0.0, 5.0, 0.0, 0.0, 1.0])
+    else:
+        psi = np.concatenate([[0.0], np.geomspace(1e-10, 0.2, 2500),
+                              np.linspace(0.2, math.pi, 1001)[1:]])
+        q = np.exp(-20.0 * psi) * np.sin(psi) + 1e-9
+        if shape == "zero_beyond_1_rad":
+            q = np.where(psi > 1.0, 0.0, q)
+    psi, q, cdf = phase_tables.normalised(psi, q)
+    guide = phase_tables.guide(cdf)
+    n = len(psi)
+    pool = np.concatenate([psi, q, cdf])
+    cells = n - 1
+    edges = np.arange(cells + 1) / cells
+    u = np.concatenate([np.random.default_rng(3).random(20_000), edges[:-1],
+                        np.nextafter(edges[1:], 0.0), np.nextafter(edges[:-1], 1.0), cdf[:-1]])
+    u = u[u < 1.0]   # the kernel's uniform draws lie in [0, 1)
+    expected = np.searchsorted(cdf, u, side="right") - 1
+    found = np.array([tabulated.sample_angle(pool, guide, 0, n, 2 * n, 0, n, x)[0] for x in u])
+    assert np.array_equal(found, expected)

@@ -208,6 +208,8 @@ FEATURES: list[tuple[str, dict]] = [
     ("rough surface (cox_munk, 5 m/s)", {"surface": {"model": "cox_munk", "n_water": 1.34,
                                                      "wind_speed_m_s": 5.0}}),
     ("analog estimator", {"estimator.mode": "analog"}),
+    ("Petzold phase function (tabulated)", {"water": {"layers": [
+        {"thickness_m": 1, "a": 0.1, "b": 0.9, "phase": {"model": "petzold"}}]}}),
 ]
 
 # The same rows as measured with the kernel before the component records (c077515's

@@ -42,7 +42,8 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 #               tab_start); mix_coef
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
-#               comp_psi_start (n_comps); mix_ptr (n_layers + 1), mix_comp, mix_at: the terms
+#               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
+#               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1), mix_comp, mix_at: the terms
 #               of each layer's volume scattering functions, all wavelengths side by side
 #               (scene/medium.py scattering_terms, kernel/spectral.py)
 MEDIUM = _record(
@@ -51,13 +52,14 @@ MEDIUM = _record(
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
     "tab_psi", "tab_q", "tab_cdf", "mix_coef",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
-    "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp", "mix_at",
+    "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr", "mix_comp",
+    "mix_at",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
           "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
           "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
           "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
-          "comp_tab_start", "comp_tab_len", "comp_psi_start", "mix_ptr", "mix_comp",
-          "mix_at"))
+          "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
+          "mix_comp", "mix_at"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann

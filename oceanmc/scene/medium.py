@@ -167,7 +167,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     if n_wl > 1:
         _spectral_checks(config, layers)
     comp_start, comp_count, shares, comp_model, comp_params = [], [], [], [], []
-    tab_start, tab_len, psi_start, q_parts, cdf_parts = [], [], [], [], []
+    tab_start, tab_len, psi_start, q_parts, cdf_parts, guide_parts = [], [], [], [], [], []
     comp_tables: list = []      # (grid offset, q) of each tabulated component
     tab_offset = 0
     table_at: dict[int, tuple[int, int]] = {}
@@ -197,6 +197,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
                     table_at[key] = (tab_offset, len(table[0]))
                     q_parts.append(table[1])
                     cdf_parts.append(table[2])
+                    guide_parts.append(phase_tables.guide(table[2]))
                     tab_offset += len(table[0])
                 psi_key = np.ascontiguousarray(table[0]).tobytes()
                 if psi_key not in grid_at:
@@ -255,6 +256,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_start=i.add(comp_start), comp_count=i.add(comp_count),
         comp_model=i.add(comp_model), comp_tab_start=i.add(tab_start),
         comp_tab_len=i.add(tab_len), comp_psi_start=i.add(psi_start),
+        tab_guide=i.add(np.concatenate(guide_parts) if guide_parts else np.zeros(0, np.int64)),
         mix_ptr=i.add(mix_ptr), mix_comp=i.add(mix_comp), mix_at=i.add(mix_at),
         mix_coef=f.add(mix_coef))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers))

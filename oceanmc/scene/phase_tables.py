@@ -31,6 +31,15 @@ def cumulative(psi: np.ndarray, q: np.ndarray) -> np.ndarray:
     return cdf / cdf[-1]
 
 
+def guide(cdf: np.ndarray) -> np.ndarray:
+    """The sampler's guide table (kernel/phase/tabulated.py): with G = len(cdf) - 1 cells of
+    equal probability, entry k is the interval i that holds k / G (cdf[i] <= k / G < cdf[i +
+    1]; the last interval for k = G)."""
+    cells = len(cdf) - 1
+    at = np.searchsorted(cdf, np.arange(cells + 1) / cells, side="right") - 1
+    return np.clip(at, 0, cells - 1).astype(np.int64)
+
+
 def normalised(psi: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(psi, q, cdf) with q scaled so that its piecewise-linear integral is 1."""
     total = float(np.sum(0.5 * (q[1:] + q[:-1]) * np.diff(psi)))

@@ -26,6 +26,12 @@ def table_at(medium, mi, k):
             medium.tab_cdf + start, mi[medium.comp_tab_len + k])
 
 
+@kernel
+def guide_at(medium, mi, k):
+    """The int pool offset of component k's guide table (tabulated.sample_angle)."""
+    return medium.tab_guide + mi[medium.comp_tab_start + k]
+
+
 @hot
 def sample_component(medium, mf, mi, k, u):
     model = mi[medium.comp_model + k]
@@ -33,7 +39,8 @@ def sample_component(medium, mf, mi, k, u):
         return henyey_greenstein.sample(component_params(medium, mf, k), u)
     if model == PHASE_TABULATED:
         psi_at, q_at, cdf_at, length = table_at(medium, mi, k)
-        return tabulated.sample(mf, psi_at, q_at, cdf_at, length, u)
+        return tabulated.sample(mf, mi, psi_at, q_at, cdf_at, guide_at(medium, mi, k), length,
+                                u)
     if model == PHASE_QUADRATIC:
         return quadratic.sample(component_params(medium, mf, k), u)
     return isotropic.sample(component_params(medium, mf, k), u)
@@ -79,7 +86,8 @@ def sample_angle(medium, mf, mi, k, u):
     evaluates tables on the same grid their search; otherwise grid offset and node are -1."""
     if mi[medium.comp_model + k] == PHASE_TABULATED:
         psi_at, q_at, cdf_at, length = table_at(medium, mi, k)
-        node, angle = tabulated.sample_angle(mf, psi_at, q_at, cdf_at, length, u)
+        node, angle = tabulated.sample_angle(mf, mi, psi_at, q_at, cdf_at,
+                                             guide_at(medium, mi, k), length, u)
         return math.cos(angle), angle, psi_at, node
     cos_psi = sample_component(medium, mf, mi, k, u)
     return cos_psi, math.acos(min(1.0, max(-1.0, cos_psi))), -1, -1
