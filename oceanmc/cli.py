@@ -348,7 +348,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if bare_walk is None:
         print("oceanmc: bench: shared/bench/bare_walk.py not found; the speed ceiling is "
               "reported without it (--bare-walk PATH)", file=sys.stderr)
-    return bench.main(Path(args.output), configs, bare_walk, quick=args.quick)
+    return bench.main(Path(args.output), configs, bare_walk, quick=args.quick,
+                      speed_only=args.speed)
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -424,6 +425,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("-o", "--output", default="benchmarks", metavar="DIR",
                        help="report folder (default: benchmarks)")
     bench.add_argument("--quick", action="store_true", help="small counts: a smoke test")
+    bench.add_argument("--speed", action="store_true",
+                       help="only the speed ceiling, the feature costs and the start-up rows "
+                            "(DIR/speed.md): what a change to the kernel reports")
     bench.add_argument("--spectral", action="store_true",
                        help="only the spectral section (one history against 31 runs): "
                             "DIR/spectral.md")

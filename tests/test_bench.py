@@ -110,3 +110,23 @@ def test_spectral_section_splits_the_worst_band_into_time_and_variance():
         in text
     assert "crossing" not in text.split("|---")[-1]   # a quantity the run did not measure
     assert "| water-leaving fraction | 10.0 (420 nm) | 4.0 x 2.50 | 11.0 | 15.0 | yes |" in text
+
+
+def test_speed_section_alone_writes_speed_report(tmp_path):
+    """`oceanmc bench --speed`: the speed ceiling, feature costs and start-up rows alone, in
+    DIR/speed.md (what a change to the kernel reports), without the long error-vs-time runs."""
+    bare_walk = REPO.parent / "shared" / "bench" / "bare_walk.py"
+    args = [sys.executable, "-m", "oceanmc", "bench", "--speed", "--quick", "-o",
+            str(tmp_path / "s"), "--configs", str(REPO / "configs")]
+    if bare_walk.is_file():
+        args += ["--bare-walk", str(bare_walk)]
+    done = subprocess.run(args, capture_output=True, text=True, timeout=1800, cwd=REPO)
+    assert done.returncode == 0, done.stderr[-3000:]
+    data = json.loads((tmp_path / "s" / "speed.json").read_text())
+    assert set(data) >= {"speed_ceiling", "features", "startup"}
+    assert "error_vs_time" not in data and "spectral" not in data
+    assert "Petzold phase function (tabulated)" in {row["variant"] for row in data["features"]}
+    report = (tmp_path / "s" / "speed.md").read_text()
+    assert "## Speed ceiling" in report and "## Start-up" in report
+    assert "Error against run time" not in report
+    assert not (tmp_path / "s" / "bench.md").exists()

@@ -14,7 +14,8 @@ Everything is measured in one run on this machine, so ratios compare like with l
 - start-up, each in a fresh process against a target: `oceanmc run` of four scenes with an
   empty compilation cache of their own (one scene with --quick) and with the cache filled,
   `oceanmc --help`, and a cached 20,000-photon run of configs/default.yaml.
-Writes DIR/bench.md, DIR/bench.json and DIR/error_vs_time.png.
+Writes DIR/bench.md, DIR/bench.json and DIR/error_vs_time.png; `--speed` only the speed
+ceiling, feature costs and start-up (DIR/speed.md, DIR/speed.json).
 
 scenes.py defines what is run, measure.py runs and times it, report.py writes the report.
 """
@@ -27,12 +28,15 @@ from pathlib import Path
 
 from .measure import error_vs_time, feature_costs, long_run_reference, speed_ceiling, startup
 from .report import (fom_ratios, fom_summary, roulette_ratios, sampling_ratios, upward_ratios,
-                     write_report)
+                     write_report, write_speed_report)
 from . import spectral
 from .scenes import SKY_SPOT, scenes, sky_spot_map, sky_spot_scenes, startup_scenes
 
 
-def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool = False) -> int:
+def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool = False,
+         speed_only: bool = False) -> int:
+    """The whole benchmark (DIR/bench.md), or with speed_only the speed ceiling, the feature
+    costs and the start-up rows alone (DIR/speed.md: what a change to the kernel reports)."""
     import platform
 
     import numba
@@ -54,6 +58,13 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
     data["speed_ceiling"] = speed_ceiling(configs_dir, bare_walk, photons, repeats)
     say("feature costs ...")
     data["features"] = feature_costs(configs_dir, photons, repeats, quick)
+    if speed_only:
+        say("start-up ...")
+        with tempfile.TemporaryDirectory() as tmp:
+            data["startup"] = startup(startup_scenes(configs_dir, Path(tmp)), Path(tmp), quick)
+        write_speed_report(out_dir, data)
+        say(f"wrote {out_dir / 'speed.md'}")
+        return 0
     data["error_vs_time"] = []
     long_runs: dict[str, tuple] = {}
     for scene in scenes(configs_dir):

@@ -48,15 +48,10 @@ def plot(curves: list[dict], path: Path) -> None:
     save(fig, path)
 
 
-def write_report(out_dir: Path, data: dict) -> None:
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "bench.json").write_text(json.dumps(data, indent=1))
-    plot(data["error_vs_time"], out_dir / "error_vs_time.png")
+def speed_lines(data: dict) -> list[str]:
+    """The speed ceiling, feature-cost and start-up sections of the report."""
     s = data["speed_ceiling"]
-    lines = ["# oceanmc benchmark", "",
-             f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
-             f"numba {data['numba']}. Regenerate with `oceanmc bench -o {out_dir}`.", "",
-             "## Speed ceiling (bare-walk scene: tau = 1, albedo 0.9, isotropic, n = 1.34, "
+    lines = ["## Speed ceiling (bare-walk scene: tau = 1, albedo 0.9, isotropic, n = 1.34, "
              "pencil beam)", "",
              f"Medians of {s['repeats']} runs of {s['photons']:,} photons, compilation "
              "excluded; oceanmc tallies Ed, Eu, Eod, Eou and radiance quads at 0 and 1 m.", "",
@@ -100,6 +95,29 @@ def write_report(out_dir: Path, data: dict) -> None:
         lines.append(f"| {row['row']} | {row['scene'] or '-'} | {row['process_s']:.2f} | "
                      f"{kernel} | {measure} <= {row['target_s']:g} s | "
                      f"{'pass' if row['pass'] else 'FAIL'} |")
+    return lines
+
+
+def write_speed_report(out_dir: Path, data: dict) -> None:
+    """DIR/speed.md and DIR/speed.json (`oceanmc bench --speed`): the speed ceiling, the
+    feature costs and the start-up rows alone (what a change to the kernel reports)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "speed.json").write_text(json.dumps(data, indent=1))
+    lines = ["# oceanmc benchmark: speed and start-up", "",
+             f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
+             f"numba {data['numba']}. Regenerate with `oceanmc bench --speed -o DIR` (the full "
+             "`oceanmc bench` has these sections in bench.md).", ""]
+    (out_dir / "speed.md").write_text("\n".join(lines + speed_lines(data)) + "\n")
+
+
+def write_report(out_dir: Path, data: dict) -> None:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "bench.json").write_text(json.dumps(data, indent=1))
+    plot(data["error_vs_time"], out_dir / "error_vs_time.png")
+    lines = ["# oceanmc benchmark", "",
+             f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
+             f"numba {data['numba']}. Regenerate with `oceanmc bench -o {out_dir}`.", ""]
+    lines += speed_lines(data)
     lines += ["", "## Error against run time", "",
               "FOM = 1 / (relative standard error^2 x wall time), median over the photon "
               "counts; `z` is (value - reference) / combined standard error.", "",
