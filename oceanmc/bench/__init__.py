@@ -33,6 +33,12 @@ from . import spectral
 from .scenes import SKY_SPOT, scenes, sky_spot_map, sky_spot_scenes, startup_scenes
 
 
+def _startup(configs_dir: Path, quick: bool, say) -> dict:
+    say("start-up ...")
+    with tempfile.TemporaryDirectory() as tmp:
+        return startup(startup_scenes(configs_dir, Path(tmp)), Path(tmp), quick)
+
+
 def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool = False,
          speed_only: bool = False) -> int:
     """The whole benchmark (DIR/bench.md), or with speed_only the speed ceiling, the feature
@@ -59,9 +65,7 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
     say("feature costs ...")
     data["features"] = feature_costs(configs_dir, photons, repeats, quick)
     if speed_only:
-        say("start-up ...")
-        with tempfile.TemporaryDirectory() as tmp:
-            data["startup"] = startup(startup_scenes(configs_dir, Path(tmp)), Path(tmp), quick)
+        data["startup"] = _startup(configs_dir, quick, say)
         write_speed_report(out_dir, data)
         say(f"wrote {out_dir / 'speed.md'}")
         return 0
@@ -88,10 +92,8 @@ def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool =
                 reference=(values, stderrs, f"{source}, importance sampling")))
     say("spectral: one history against 31 runs ...")
     data["spectral"] = spectral.measure(quick, say)
-    say("start-up ...")
-    with tempfile.TemporaryDirectory() as tmp:
-        # last: with --quick the cached rows use this process's cache, filled by the runs above
-        data["startup"] = startup(startup_scenes(configs_dir, Path(tmp)), Path(tmp), quick)
+    # last: with --quick the cached rows use this process's cache, filled by the runs above
+    data["startup"] = _startup(configs_dir, quick, say)
     data["fom"] = fom_summary(data["error_vs_time"])
     data["fom_ratios"] = fom_ratios(data["fom"])
     data["roulette_ratios"] = roulette_ratios(data["fom"])

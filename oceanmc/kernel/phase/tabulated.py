@@ -21,7 +21,8 @@ EDGE = 1e-12
 @kernel
 def sample_angle(pool, guide, psi_at, q_at, cdf_at, guide_at, length, u):
     """(node i, angle psi) sampled by inverting the CDF, psi[i] <= psi <= psi[i + 1]; guide:
-    the int pool holding the table's guide at guide_at (length entries, guide_cells)."""
+    the int pool holding the table's guide at guide_at (length entries,
+    scene/phase_tables.py guide)."""
     cells = length - 1
     cell = min(int(u * cells), cells - 1)
     lo = guide[guide_at + cell]
