@@ -90,18 +90,20 @@ SKY = _record(
 #   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: K, G,
 #               F (n_wl each), D, beta (n_wl)); every scene: the local estimates' scratch
 #               (kernel/local_estimate.py: weight, tau, phase (n_wl each)), and their scores,
-#               local ((n_depths + 1) x n_dirs x n_wl) and cap ((n_depths + 1) x n_wl); then
-#               one block of wl_stride per wavelength: flux (n_levels x 4), radiance (n_levels
-#               x n_theta_cols x n_phi_cols), budget (n_budget); the offsets below are those of
-#               the first block
+#               local ((n_depths + 1) x n_dirs x n_wl) and cap ((n_depths + 1) x n_wl); then,
+#               from `scores` on, flux (n_levels x 4), radiance (n_levels x n_theta_cols x
+#               n_phi_cols), budget (n_budget), each score with its n_wl wavelengths side by
+#               side: the offsets below are those of one wavelength's layout, and the score at
+#               offset i of wavelength j lies at scores + (i - scores) n_wl + j (tally.py
+#               spectral_at: the same address when n_wl = 1)
 GRID = _record(
-    "n_wl", "wl_stride", "spectral", "scratch", "source_q", "bottom_q",
+    "n_wl", "scores", "spectral", "scratch", "source_q", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
     "n_lookup", "theta_cols", "phi_cols",
     "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
     "theta_lookup", "theta_is_cap",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "wl_stride", "spectral", "scratch", "source_q", "bottom_q",
+    ints=("n_wl", "scores", "spectral", "scratch", "source_q", "bottom_q",
           "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
           "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
           "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",

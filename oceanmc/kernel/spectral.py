@@ -58,6 +58,7 @@ from .models import BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, PHASE_TABUL
 from .phase import dispatch as phase
 from .phase import tabulated
 from .rng import uniform
+from .tally import spectral_at
 
 # a K_j past this settles the packet (its exponentials bring the K back near 1), long before
 # products of ratios could overflow
@@ -145,13 +146,12 @@ def settle(medium, mf, grid, tally, p, layer):
     else:
         g_norm = norm
     w = p.w
-    absorbed = grid.budget + BUDGET_LAYERS + layer
-    stride = grid.wl_stride
+    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(n):
         k[j] *= norm
         g[j] *= g_norm
         now = w * g[j]
-        tally[absorbed + j * stride] += last[j] - now
+        tally[absorbed + j] += last[j] - now
         last[j] = now
 
 
@@ -288,10 +288,9 @@ def scatter(medium, mf, mi, grid, tally, p, layer, u_pick, u):
 def lose(grid, tally, layer):
     """The packet lost roulette in `layer`: what it carried at its last settle stays there."""
     _, _, last = weights(grid, tally)
-    absorbed = grid.budget + BUDGET_LAYERS + layer
-    stride = grid.wl_stride
+    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(grid.n_wl):
-        tally[absorbed + j * stride] += last[j]
+        tally[absorbed + j] += last[j]
 
 
 @kernel
@@ -308,12 +307,11 @@ def attenuate(medium, mf, grid, tally, p, layer, dist):
             g[j] *= math.exp(-c[j] * dist)
         return False
     settle(medium, mf, grid, tally, p, layer)
-    absorbed = grid.budget + BUDGET_LAYERS + layer
-    stride = grid.wl_stride
+    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
+    lost = spectral_at(grid, grid.budget + BUDGET_LOST_BELOW)
     w = p.w
     for j in range(n):
-        where = absorbed if c[j] > 0.0 else grid.budget + BUDGET_LOST_BELOW
-        tally[where + j * stride] += w * g[j]
+        tally[(absorbed if c[j] > 0.0 else lost) + j] += w * g[j]
     return True
 
 
@@ -324,11 +322,10 @@ def reflect(grid, gf, tally, p, rho):
     n = grid.n_wl
     _, g, _ = weights(grid, tally)
     share = gf[grid.bottom_q:grid.bottom_q + n]
-    absorbed = grid.budget + BUDGET_BOTTOM
-    stride = grid.wl_stride
+    absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
     w = p.w
     for j in range(n):
-        tally[absorbed + j * stride] += w * g[j] * (1.0 - rho * share[j])
+        tally[absorbed + j] += w * g[j] * (1.0 - rho * share[j])
         g[j] *= share[j]
     p.w *= rho
     carry(grid, tally, p)

@@ -10,8 +10,9 @@ Eod, Eou, radiance), in one flat row per batch (kernel/records.py, GRID). Levels
 tally depths first, then grid.air_level (0+, all light) and grid.air_level + 1 (0+, water-leaving
 light only).
 
-Spectral scenes (kernel/spectral.py) hold one block of scores per wavelength, wl_stride apart;
-score() adds a packet's weight to every block, times the wavelength's share q of it."""
+Spectral scenes (kernel/spectral.py) hold every score with its wavelengths side by side
+(spectral_at); score() adds a packet's weight to each wavelength, times the wavelength's share q
+of it."""
 import math
 
 from .compile import kernel
@@ -103,15 +104,25 @@ def inverse_mu(uz, mu_cut, beam):
 
 
 @kernel
+def spectral_at(grid, index):
+    """Where wavelength 0's value of score `index` (its offset in one wavelength's layout: the
+    GRID record's offsets) lies in a spectral row: each score's n_wl wavelengths side by side
+    from there, so scoring every wavelength of a packet writes one short stretch of memory
+    (records.py, GRID)."""
+    return grid.scores + (index - grid.scores) * grid.n_wl
+
+
+@kernel
 def score(grid, tally, index, w):
-    """Adds weight w at `index` of the first wavelength's block, and in a spectral scene w times
-    each wavelength's share q (kernel/spectral.py) in that wavelength's block."""
+    """Adds weight w to score `index` (its offset in one wavelength's layout), and in a
+    spectral scene w times each wavelength's share q (kernel/spectral.py) to that wavelength's."""
     if grid.n_wl == 1:
         tally[index] += w
         return
     q = grid.spectral + grid.n_wl
+    at = spectral_at(grid, index)
     for j in range(grid.n_wl):
-        tally[index + j * grid.wl_stride] += w * tally[q + j]
+        tally[at + j] += w * tally[q + j]
 
 
 @kernel
@@ -134,10 +145,13 @@ def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
             tally[quad] += w_over_mu
         return
     q = grid.spectral + grid.n_wl
+    plane = spectral_at(grid, plane)
+    scalar = spectral_at(grid, scalar)
     for j in range(grid.n_wl):
-        block = j * grid.wl_stride
         share = tally[q + j]
-        tally[plane + block] += w * share
-        tally[scalar + block] += w_over_mu * share
-        if quad >= 0:
-            tally[quad + block] += w_over_mu * share
+        tally[plane + j] += w * share
+        tally[scalar + j] += w_over_mu * share
+    if quad >= 0:
+        quad = spectral_at(grid, quad)
+        for j in range(grid.n_wl):
+            tally[quad + j] += w_over_mu * tally[q + j]

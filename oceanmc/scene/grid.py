@@ -94,9 +94,9 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
     (a depth profile's sublayers each absorb into a budget column of their own). A spectral
-    scene's row holds the packet's spectral state first (kernel/spectral.py), then one block
-    per wavelength; bottom_shares: each wavelength's bottom
-    reflectance relative to the packed BRDF's (default 1)."""
+    scene's row holds the packet's spectral state first (kernel/spectral.py), and all its
+    scores with the wavelength fastest; bottom_shares: each wavelength's bottom reflectance
+    relative to the packed BRDF's (default 1)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
@@ -106,9 +106,7 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
     # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength), the
-    # local estimates' scratch (weight, tau, phase per wavelength), then their scores with the
-    # wavelength fastest (a collision scores every wavelength at the same level: one stretch
-    # of memory, not one block per wavelength)
+    # local estimates' scratch (weight, tau, phase per wavelength), then their scores
     scratch = 4 * n_wl + 1 if n_wl > 1 else 0
     local = scratch + 3 * n_wl
     cap = local + (n_depths + 1) * n_dirs * n_wl
@@ -118,13 +116,15 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
                          ("budget", n_budget)):
         layout[name] = size
         size += length
-    wl_stride = size - shared_size
-    size = shared_size + n_wl * wl_stride
+    # every score with its wavelengths side by side (kernel/tally.py spectral_at): a crossing
+    # or a settle adds to all wavelengths of a score at once, a few cache lines instead of one
+    # per wavelength
+    size = shared_size + n_wl * (size - shared_size)
     _, diffuse, _ = optics.illumination_spectrum(config)
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
-        GRID, n_wl=n_wl, wl_stride=wl_stride, spectral=0, scratch=scratch,
+        GRID, n_wl=n_wl, scores=shared_size, spectral=0, scratch=scratch,
         source_q=f.add(source_q),
         bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
@@ -147,15 +147,16 @@ def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
     g = grid_record[0]
     nb = tallies.shape[0]
     n_levels = int(g["n_depths"]) + 2
-    block = wavelength * int(g["wl_stride"])
+    n_wl = int(g["n_wl"])
+    scores = int(g["scores"])
 
     def part(name, length, shape):
-        at = int(g[name]) + block
-        return tallies[:, at:at + length].reshape((nb,) + shape)
+        """A score array of the per-wavelength scores (kernel/tally.py spectral_at)."""
+        at = scores + (int(g[name]) - scores) * n_wl + wavelength
+        return tallies[:, at:at + length * n_wl:n_wl].reshape((nb,) + shape)
 
     def side_by_side(name, shape):
-        """A score array with every wavelength's values side by side (wavelength fastest)."""
-        n_wl = int(g["n_wl"])
+        """A score array of the local estimates (wavelength fastest too)."""
         at = int(g[name])
         length = int(np.prod(shape)) * n_wl
         return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))[..., wavelength]
