@@ -136,3 +136,39 @@ def test_a_huge_run_stops_within_seconds(tmp_path, signal_number):
     assert result.attrs["partial"] and result.attrs["batches"] == 0
     assert sorted(result.resume_state["batch"]) == [0, 1]
     assert (result.resume_state["next_photon"] > 0).all()
+
+
+def test_spectral_run_resumes_and_an_earlier_layout_is_refused(tmp_path, small_scene,
+                                                               monkeypatch):
+    """A spectral run stopped mid-batch resumes bit for bit (its raw tally rows hold every
+    score's wavelengths side by side, scene/grid.py TALLY_LAYOUT); a partial file whose
+    unfinished batches carry no layout (written before the layout was recorded, when each
+    wavelength had a block of its own) is refused by --resume with one line, exit status 2,
+    and left as it was."""
+    small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 550.0, 650.0])
+    full = oceanmc.simulate(small_scene, threads=2)
+    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
+    monkeypatch.setattr(simulation, "POLL_SECONDS", 0.001)
+    part = oceanmc.simulate(small_scene, threads=2, should_stop=stop_after(0))
+    assert part.attrs["partial"] and part.resume_state is not None
+    out = tmp_path / "p.h5"
+    part.save(out)
+    part = load_result(out)
+    rest = oceanmc.simulate(small_scene, threads=2, resume_state=part.resume_state)
+    done = merge_results([part, rest], resume=True)
+    for name, q in full.quantities.items():
+        assert np.array_equal(done.quantities[name].batches, q.batches), name
+
+    import h5py
+    with h5py.File(out, "a") as f:
+        del f["resume/tally_layout"]
+    before = out.read_bytes()
+    config = tmp_path / "s.yaml"
+    config.write_text(yaml.safe_dump(small_scene))
+    run = subprocess.run([sys.executable, "-m", "oceanmc", "run", config, "-o", out, "--resume"],
+                         cwd=tmp_path, env=ENV, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 2, run.stderr
+    message = run.stderr.strip()
+    assert "Traceback" not in message and len(message.splitlines()) == 1, message
+    assert "tally layout 1" in message and "cannot be continued" in message, message
+    assert out.read_bytes() == before

@@ -37,7 +37,8 @@ RESUME_GROUP = "resume"
 RESUME_FIELDS = ("batch", "rng", "beam", "next_photon", "events", "tally")
 RESUME_DESCRIPTION = ("state of the batches begun but not finished when the run stopped, "
                       "not part of the estimates: batch index, random stream (xoshiro256**), "
-                      "entered sun beam, next photon, scattering events, raw tally row")
+                      "entered sun beam, next photon, scattering events, raw tally row and "
+                      "its layout (scene/grid.py TALLY_LAYOUT)")
 
 AUXILIARY_COORDS = {"direction_theta": "direction", "direction_phi": "direction"}
 
@@ -339,6 +340,9 @@ def _read(f: h5py.File) -> Result:
     resume_state = None
     if RESUME_GROUP in f:
         resume_state = {name: _dataset(f[RESUME_GROUP], name, "fciu") for name in RESUME_FIELDS}
+        # files written before the layout was recorded hold layout 1 (scene/grid.py)
+        resume_state["tally_layout"] = (_dataset(f[RESUME_GROUP], "tally_layout", "iu")
+                                        if "tally_layout" in f[RESUME_GROUP] else np.array(1))
     iops = {name: _dataset(f["iops"], name) for name in f["iops"]} if "iops" in f else {}
     return Result(coords, quantities, attrs, resume_state, iops)
 

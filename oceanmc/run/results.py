@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..kernel import models
+from ..scene.grid import TALLY_LAYOUT
 
 
 @dataclass
@@ -133,11 +134,19 @@ def check_same_data_files(stored: dict, current: dict, what: str) -> None:
 
 def check_resumable(part: Result) -> None:
     """Raises MergeError when part holds several runs (a merge): their unfinished batches are
-    not kept and their batch ranges are not one run's, so it cannot be continued."""
+    not kept and their batch ranges are not one run's, so it cannot be continued; or when its
+    unfinished batches are spectral tally rows of another layout than this oceanmc's."""
     if "merged_from" in part.attrs or "seeds" in part.attrs:
         raise MergeError(f"it merges {part.attrs.get('merged_from', 'several')} runs (seeds "
                          f"{part.attrs.get('seeds')}) and cannot be continued: resume each "
                          "partial run in its own file, then merge them")
+    state = part.resume_state
+    if state is not None and "wavelength" in part.coords \
+            and int(state.get("tally_layout", 1)) != TALLY_LAYOUT:
+        raise MergeError(f"its unfinished batches were stored by an earlier oceanmc, in spectral "
+                         f"tally layout {int(state.get('tally_layout', 1))} (this oceanmc's is "
+                         f"{TALLY_LAYOUT}), and cannot be continued: its whole batches stay "
+                         "readable; run the scene again for the rest")
 
 
 def merge_results(parts: list[Result], *, resume: bool = False) -> Result:

@@ -29,7 +29,7 @@ from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes,
 from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, SPLIT_STACK_ROWS
 from ..kernel.rng import STATE_WORDS, batch_state
-from ..scene.grid import tally_views
+from ..scene.grid import TALLY_LAYOUT, tally_views
 from .compiling import ready
 from .results import Result, from_tallies, stack_wavelengths, sun_of
 
@@ -185,7 +185,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                      "beam": np.empty((len(begun), 4)),
                      "next_photon": np.empty(len(begun), dtype=np.int64),
                      "events": np.empty(len(begun), dtype=np.int64),
-                     "tally": np.empty((len(begun), sc.tally_size))}
+                     "tally": np.empty((len(begun), sc.tally_size)),
+                     "tally_layout": np.array(TALLY_LAYOUT)}
             for k, b in enumerate(begun):
                 with locks[b]:
                     state["rng"][k] = rngs[b, :STATE_WORDS]

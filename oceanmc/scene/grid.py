@@ -13,6 +13,11 @@ from ..kernel import models
 from ..kernel.records import GRID, Pool, record
 
 THETA_LOOKUP_CELLS = 4096
+# the layout of a batch's raw tally row, in which a partial run keeps its unfinished batches
+# (run/hdf5.py): 2, every spectral score with its wavelengths side by side; 1 (files before
+# 2026-11-25, none marked), one block of scores per wavelength. A one-wavelength row is the same
+# in both.
+TALLY_LAYOUT = 2
 
 
 @dataclass(frozen=True)
