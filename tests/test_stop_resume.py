@@ -6,6 +6,7 @@ import subprocess
 import sys
 import time
 
+import h5py
 import numpy as np
 import pytest
 import yaml
@@ -159,7 +160,6 @@ def test_spectral_run_resumes_and_an_earlier_layout_is_refused(tmp_path, small_s
     for name, q in full.quantities.items():
         assert np.array_equal(done.quantities[name].batches, q.batches), name
 
-    import h5py
     with h5py.File(out, "a") as f:
         del f["resume/tally_layout"]
     before = out.read_bytes()

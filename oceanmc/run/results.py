@@ -140,11 +140,11 @@ def check_resumable(part: Result) -> None:
         raise MergeError(f"it merges {part.attrs.get('merged_from', 'several')} runs (seeds "
                          f"{part.attrs.get('seeds')}) and cannot be continued: resume each "
                          "partial run in its own file, then merge them")
-    state = part.resume_state
+    state = part.resume_state   # (run/hdf5.py reads an unmarked file's layout as 1)
     if state is not None and "wavelength" in part.coords \
-            and int(state.get("tally_layout", 1)) != TALLY_LAYOUT:
+            and int(state["tally_layout"]) != TALLY_LAYOUT:
         raise MergeError(f"its unfinished batches were stored by an earlier oceanmc, in spectral "
-                         f"tally layout {int(state.get('tally_layout', 1))} (this oceanmc's is "
+                         f"tally layout {int(state['tally_layout'])} (this oceanmc's is "
                          f"{TALLY_LAYOUT}), and cannot be continued: its whole batches stay "
                          "readable; run the scene again for the rest")
 
