@@ -5,11 +5,11 @@ import math
 
 import numpy as np
 
-from .brdf.general import first_above
 from .compile import kernel, setup
 from .geometry import from_angles
 from .models import SKY_CARDIOIDAL, SKY_HARRISON_COOMBES, SKY_MAP, SKY_MAP_COSINE
 from .rng import uniform
+from .search import interval
 
 
 @kernel
@@ -53,13 +53,15 @@ def sky_direction(sky, sf, rng):
         if model == SKY_MAP_COSINE:
             s = uniform(rng)
             phi_view = sf[sky.phi_edges] + 2.0 * math.pi * uniform(rng)
-            # the cell holding (s, phi_view): one before the first edge above it (the last cell
-            # if rounding puts phi_view on the final edge)
-            row = first_above(sf, sky.s_edges, sky.n_rows + 1, s) - 1
-            col = first_above(sf, sky.phi_edges, n_cols + 1, phi_view) - 1
+            # the cell holding (s, phi_view), edge[i] <= value < edge[i + 1]; the final edge is
+            # not read (the last cell if rounding puts phi_view on it)
+            row = interval(sf, sky.s_edges, -1, sky.n_rows, s)
+            col = interval(sf, sky.phi_edges, -1, n_cols, phi_view)
         else:
-            row = first_above(sf, sky.row_cdf, sky.n_rows, uniform(rng))
-            col = first_above(sf, sky.cell_cdf + row * n_cols, n_cols, uniform(rng))
+            # the row and cell with cdf[i - 1] <= u < cdf[i], cdf[-1] = 0; the last entry, 1, is
+            # not read
+            row = interval(sf, sky.row_cdf, -1, sky.n_rows - 1, uniform(rng)) + 1
+            col = interval(sf, sky.cell_cdf + row * n_cols, -1, n_cols - 1, uniform(rng)) + 1
             s0 = sf[sky.s_edges + row]
             s = s0 + uniform(rng) * (sf[sky.s_edges + row + 1] - s0)
             p0 = sf[sky.phi_edges + col]

@@ -26,6 +26,7 @@ import math
 
 from ..compile import kernel
 from ..models import BRDF_SAMPLER_AT
+from ..search import interval
 
 HEADER = 8
 TWO_PI = 2.0 * math.pi
@@ -60,20 +61,6 @@ def incident_nodes(n_ti, n_pi, wix, wiy, wiz):
         b = min(int(y), n_pi - 1)
         tb = min(1.0, max(0.0, y - b))
     return a, t, b, tb, phi_i
-
-
-@kernel
-def first_above(params, start, n, u):
-    """Smallest k in 0 .. n - 1 with u < params[start + k] (the last entry is 1)."""
-    lo = -1
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if u < params[start + mid]:
-            hi = mid
-        else:
-            lo = mid
-    return hi
 
 
 @kernel
@@ -138,10 +125,12 @@ def sample(params, wix, wiy, wiz, u1, u2):
             u1 = rescale(u1, 1.0 - tb, 1.0)
             b = (b + 1) % n_pi
     base = blocks + (a * n_pi + b) * block
-    c = first_above(params, base, n_p, u1)
+    # the azimuth band c, then the polar band r: the k with cdf[k - 1] <= u < cdf[k], cdf[-1] = 0
+    # (the CDF's last entry, 1, is not read)
+    c = interval(params, base, -1, n_p - 1, u1) + 1
     u1 = rescale(u1, params[base + c - 1] if c > 0 else 0.0, params[base + c])
     row = base + n_p + c * n_t
-    r = first_above(params, row, n_t, u2)
+    r = interval(params, row, -1, n_t - 1, u2) + 1
     u2 = rescale(u2, params[row + r - 1] if r > 0 else 0.0, params[row + r])
     s = params[s_at + r] + u2 * (params[s_at + r + 1] - params[s_at + r])
     mu = math.sqrt(min(1.0, max(0.0, s)))

@@ -17,6 +17,7 @@ import math
 
 from ..compile import kernel
 from ..models import BRDF_TABLE_AT
+from ..search import interval
 
 HEADER = 8
 
@@ -31,14 +32,7 @@ def locate(params, start, n, x):
         return 0, 0.0
     if x >= params[start + n - 1]:
         return n - 2, 1.0
-    lo = 0
-    hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if params[start + mid] <= x:
-            lo = mid
-        else:
-            hi = mid
+    lo = interval(params, start, 0, n - 1, x)
     x0 = params[start + lo]
     return lo, (x - x0) / (params[start + lo + 1] - x0)
 

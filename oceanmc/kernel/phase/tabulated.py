@@ -14,6 +14,7 @@ cdf[i] <= u < cdf[i + 1]."""
 import math
 
 from ..compile import kernel
+from ..search import interval
 
 EDGE = 1e-12
 
@@ -32,12 +33,7 @@ def sample_angle(pool, guide, psi_at, q_at, cdf_at, guide_at, length, u):
         lo -= 1
     while hi < length - 1 and pool[cdf_at + hi] <= u:
         hi += 1
-    while hi - lo > 1:  # cdf[lo] <= u < cdf[hi]
-        mid = (lo + hi) >> 1
-        if pool[cdf_at + mid] <= u:
-            lo = mid
-        else:
-            hi = mid
+    lo = interval(pool, cdf_at, lo, hi, u)  # cdf[lo] <= u < cdf[hi]
     need = u - pool[cdf_at + lo]
     q0 = pool[q_at + lo]
     psi0 = pool[psi_at + lo]
@@ -58,14 +54,7 @@ def sample(pool, guide, psi_at, q_at, cdf_at, guide_at, length, u):
 def locate(pool, psi_at, length, angle):
     """(node i, fraction) with psi[i] <= angle < psi[i + 1] in the table's angle grid: where the
     angle falls, for every table on that grid (phase/dispatch.py searches a shared grid once)."""
-    lo = 0
-    hi = length - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if pool[psi_at + mid] <= angle:
-            lo = mid
-        else:
-            hi = mid
+    lo = interval(pool, psi_at, 0, length - 1, angle)
     psi0 = pool[psi_at + lo]
     return lo, (angle - psi0) / (pool[psi_at + lo + 1] - psi0)
 
