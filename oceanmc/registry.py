@@ -61,6 +61,12 @@ SURFACE = {
     "cox_munk": (models.SURFACE_COX_MUNK, "cox_munk"),
 }
 
+# Collision channels: name -> (kernel model id, module in kernel/channels/). Elastic scattering
+# is every scene's; inelastic processes (water.inelastic) add theirs.
+CHANNEL = {
+    "elastic": (models.CHANNEL_ELASTIC, "elastic"),
+}
+
 # Sky radiance shapes: schema name -> kernel model id; a map ({map: FILE}) is SKY_MAP or, with
 # sampling: cosine, SKY_MAP_COSINE. All are sampled by kernel/sources.py.
 SKY = {

@@ -15,6 +15,7 @@ import oceanmc
 from oceanmc.run import simulation
 from oceanmc.run.hdf5 import load_result
 from oceanmc.run.results import MergeError, merge_results
+from oceanmc.scene.grid import tally_arrays, tally_views, write_tally_arrays
 
 from conftest import REPO
 from test_robustness import ENV
@@ -139,13 +140,46 @@ def test_a_huge_run_stops_within_seconds(tmp_path, signal_number):
     assert (result.resume_state["next_photon"] > 0).all()
 
 
-def test_spectral_run_resumes_and_an_earlier_layout_is_refused(tmp_path, small_scene,
-                                                               monkeypatch):
-    """A spectral run stopped mid-batch resumes bit for bit (its raw tally rows hold every
-    score's wavelengths side by side, scene/grid.py TALLY_LAYOUT); a partial file whose
-    unfinished batches carry no layout (written before the layout was recorded, when each
-    wavelength had a block of its own) is refused by --resume with one line, exit status 2,
-    and left as it was."""
+def test_tally_arrays_round_trip_exactly():
+    """A spectral scene's tally rows as named arrays (wavelength last) and back, bit for bit:
+    views -> rows -> views, and rows -> views -> rows on every score; the arrays are disjoint
+    (random values survive the round trip) and tally_views is their slice at one wavelength."""
+    config = oceanmc.load_config({
+        "name": "tally arrays", "wavelengths_nm": [450.0, 550.0, 650.0],
+        "water": {"layers": [{"thickness_m": 5.0, "a": 0.1, "b": 0.4},
+                             {"thickness_m": 3.0, "a": 0.2, "b": 0.2}]},
+        "bottom": {"model": "lambertian", "reflectance": 0.3},
+        "tallies": {"depths_m": [0, 2, 5], "radiance": True, "phi_bands": 12,
+                    "local_directions_deg": [[180, 0], [140, 45]]}})
+    sc = oceanmc.scene.build(config)
+    rows = np.random.default_rng(1).random((3, sc.tally_size))
+    arrays = {name: values.copy() for name, values in tally_arrays(sc.grid, rows).items()}
+    n_levels, n_wl = len(config.tallies.depths_m) + 2, 3
+    assert arrays["flux"].shape == (3, n_levels, 4, n_wl)
+    n_theta = len(config.tallies.theta_edges) - 1
+    assert arrays["radiance"].shape == (3, n_levels, n_theta, 12, n_wl)
+    n_dirs = int(sc.grid[0]["n_dirs"])   # kernel rows: in water, and refracted to the air
+    assert n_dirs >= 2 and arrays["local"].shape == (3, n_levels - 1, n_dirs, n_wl)
+    assert arrays["cap"].shape == (3, n_levels - 1, n_wl)
+    assert arrays["budget"].shape[-1] == n_wl
+    rebuilt = np.full_like(rows, np.nan)
+    write_tally_arrays(sc.grid, arrays, rebuilt)
+    for name, values in tally_arrays(sc.grid, rebuilt).items():
+        assert np.array_equal(values, arrays[name]), name
+    scores = ~np.isnan(rebuilt)   # every cell a score array wrote holds the row's value
+    assert scores.sum() == sum(values.size for values in arrays.values())
+    assert np.array_equal(rebuilt[scores], rows[scores])
+    for j in range(n_wl):
+        for name, values in tally_views(sc.grid, rows, j).items():
+            assert np.array_equal(values, arrays[name][..., j]), name
+    with pytest.raises(ValueError, match="tally cap is"):
+        write_tally_arrays(sc.grid, dict(arrays, cap=arrays["cap"][..., :2]), rebuilt)
+
+
+def test_spectral_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_scene, monkeypatch):
+    """A spectral run stopped mid-batch resumes bit for bit from its file (the unfinished
+    batches' tallies stored as named arrays, resume/tally/<name>); a scene whose tallies have
+    another shape is refused."""
     small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 550.0, 650.0])
     full = oceanmc.simulate(small_scene, threads=2)
     monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
@@ -154,15 +188,40 @@ def test_spectral_run_resumes_and_an_earlier_layout_is_refused(tmp_path, small_s
     assert part.attrs["partial"] and part.resume_state is not None
     out = tmp_path / "p.h5"
     part.save(out)
+    with h5py.File(out, "r") as f:
+        assert sorted(f["resume/tally"]) == ["budget", "cap", "flux", "local", "radiance"]
+        assert f["resume/tally/flux"].shape[-1] == 3   # wavelength last
     part = load_result(out)
     rest = oceanmc.simulate(small_scene, threads=2, resume_state=part.resume_state)
     done = merge_results([part, rest], resume=True)
     for name, q in full.quantities.items():
         assert np.array_equal(done.quantities[name].batches, q.batches), name
+    with pytest.raises(ValueError, match="tallies do not fit this scene: tally flux is"):
+        oceanmc.simulate(dict(small_scene, tallies={"depths_m": [0, 1]}),
+                         resume_state=part.resume_state)
 
-    with h5py.File(out, "a") as f:
-        del f["resume/tally_layout"]
+
+@pytest.mark.parametrize("with_layout", [False, True])
+def test_raw_tally_rows_of_an_earlier_oceanmc_are_refused(tmp_path, small_scene, monkeypatch,
+                                                          with_layout):
+    """A partial file whose resume group holds raw tally rows (an earlier oceanmc's, with or
+    without their tally_layout) cannot be continued: --resume refuses it in one line, exit
+    status 2, and leaves it as it was; its whole batches stay readable."""
+    small_scene.update(photons=60000, batches=6)
+    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
+    monkeypatch.setattr(simulation, "POLL_SECONDS", 0.005)
+    part = oceanmc.simulate(small_scene, threads=2, should_stop=stop_after(2))
+    assert part.attrs["partial"] and part.resume_state is not None
+    out = tmp_path / "p.h5"
+    part.save(out)
+    with h5py.File(out, "a") as f:   # what an earlier oceanmc wrote
+        begun = len(f["resume/batch"])
+        del f["resume/tally"]
+        f["resume/tally"] = np.zeros((begun, 500))
+        if with_layout:
+            f["resume/tally_layout"] = np.array(2)
     before = out.read_bytes()
+    assert load_result(out).attrs["batches"] == part.attrs["batches"]
     config = tmp_path / "s.yaml"
     config.write_text(yaml.safe_dump(small_scene))
     run = subprocess.run([sys.executable, "-m", "oceanmc", "run", config, "-o", out, "--resume"],
@@ -170,5 +229,6 @@ def test_spectral_run_resumes_and_an_earlier_layout_is_refused(tmp_path, small_s
     assert run.returncode == 2, run.stderr
     message = run.stderr.strip()
     assert "Traceback" not in message and len(message.splitlines()) == 1, message
-    assert "tally layout 1" in message and "cannot be continued" in message, message
+    assert "raw tally rows" in message and "cannot be continued" in message, message
+    assert f"{part.attrs['batches']} whole batches stay readable" in message, message
     assert out.read_bytes() == before

@@ -12,7 +12,8 @@ from scipy import integrate
 
 import oceanmc
 from oceanmc import scene
-from oceanmc.kernel import upward
+from oceanmc.kernel import records
+from oceanmc.kernel.channels import elastic
 from oceanmc.kernel.rng import batch_state
 
 from stats_helpers import assert_same, assert_z, dof_of
@@ -36,15 +37,25 @@ def arrays(a=0.1, b=0.4, fraction=FRACTION):
 
 
 @njit(cache=False)
-def _draw(sc, n, rng, ux, uy, uz):
-    medium, mf, mi = sc
+def _scatter(sc, n, rng, ux, uy, uz):
+    """n draws of the elastic channel (with the bias) of a packet of weight 1 travelling
+    (ux, uy, uz) in layer 0: (weights, cosines of the new directions from straight up)."""
+    medium, mf, mi, ctrl, grid, packet, ps, work, tally = sc
+    p = packet[0]
     weights = np.empty(n)
     up = np.empty(n)
     for i in range(n):
-        w, nx, ny, nz = upward.scatter(medium[0], mf, mi, 0, 1.0, ux, uy, uz, rng)
-        weights[i] = w
-        up[i] = -nz
+        p.w, p.ux, p.uy, p.uz = 1.0, ux, uy, uz
+        elastic.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, rng)
+        weights[i] = p.w
+        up[i] = -p.uz
     return weights, up
+
+
+def _draw(sc, n, rng, ux, uy, uz):
+    return _scatter((sc.medium, sc.mf, sc.mi, sc.estimator, sc.grid,
+                     np.zeros(1, dtype=records.PACKET), np.zeros(1), np.zeros(4),
+                     np.zeros(sc.tally_size)), n, rng, ux, uy, uz)
 
 
 def hg(cos_psi):
@@ -73,7 +84,7 @@ def test_biased_sampler_keeps_every_ring(theta_in_deg):
     sc = arrays()
     theta = math.radians(theta_in_deg)
     # up is -z: a direction at theta from straight up has uz = -cos(theta)
-    weights, up = _draw((sc.medium, sc.mf, sc.mi), N_DRAWS, batch_state(7, 0), math.sin(theta),
+    weights, up = _draw(sc, N_DRAWS, batch_state(7, 0), math.sin(theta),
                         0.0, -math.cos(theta))
     assert weights.max() <= 1.0 / (1.0 - FRACTION) * (1.0 + 1e-12)
     assert np.all(weights > 0.0)

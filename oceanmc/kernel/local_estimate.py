@@ -22,8 +22,9 @@ A spectral walk (kernel/spectral.py) scores every wavelength j from the same col
 reflection, with its own weight (spectral.collision_weights: the path's weight at j with the
 collision point added, w_j = F_j b_j / mean_k(K_k c_k)), phase function p_j (spectral.phase_values)
 and optical depths tau_j: the same next-event estimate, with the one-sample MIS weight of the
-path that led to it. The weights, optical depths and phase values of one event live in a scratch
-at the head of the tally row (GRID.scratch, n_wl each), a one-wavelength scene's too.
+path that led to it. The weights, optical depths and phase values of one event live in the
+batch's scratch row `work` (after a collision's volume scattering function; records.work_size),
+a one-wavelength scene's too.
 """
 import math
 
@@ -37,12 +38,12 @@ from .surface import dispatch as surface_bsdf
 
 
 @internal
-def scratch(grid, tally):
+def scratch(grid, work):
     """Views (n_wl each) of one event's weight at each wavelength, optical depth there, and
-    phase function toward the direction being scored."""
+    phase function toward the direction being scored (after the n_wl values of a collision's
+    volume scattering function, spectral.scatter_weights)."""
     n = grid.n_wl
-    m = grid.scratch
-    return tally[m:m + n], tally[m + n:m + 2 * n], tally[m + 2 * n:m + 3 * n]
+    return work[n:2 * n], work[2 * n:3 * n], work[3 * n:4 * n]
 
 
 @internal
@@ -149,17 +150,17 @@ def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m
 
 
 @internal
-def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer, w_scattered,
-                 rng):
+def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps, work, p, layer,
+                 w_scattered, rng):
     """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene)
     sends into the exact directions (at every level above it and 0+), and the polar-cap
     average of the nadir-viewing radiance, at every wavelength."""
     n = grid.n_wl
-    weight, tau, phase_j = scratch(grid, tally)
+    weight, tau, phase_j = scratch(grid, work)
     if n == 1:
         weight[0] = w_scattered
     else:
-        spectral.collision_weights(medium, mf, grid, tally, p, layer, weight)
+        spectral.collision_weights(medium, mf, grid, ps, p, layer, weight)
     z = p.z
     for j in range(n):
         tau[j] = optical_depth(medium, mf, p.seg, layer, z, j)
@@ -205,7 +206,7 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p, layer
 
 
 @internal
-def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, rng):
+def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, ps, work, p, rng):
     """Packet p meets the bottom travelling (ux, uy, uz) (in the BRDF's local frame (x, -y,
     -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
     directions, and the polar-cap average from one direction W drawn uniformly in the cap (an
@@ -213,12 +214,12 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, p, 
     water and once for the air cap, through the surface's transmittance; at every wavelength
     (one BRDF shape, each wavelength's reflectance share in its weight)."""
     n = grid.n_wl
-    weight, tau, _ = scratch(grid, tally)
+    weight, tau, _ = scratch(grid, work)
     bottom_plane = medium.n_planes - 1
     if n == 1:
         weight[0] = p.w
     else:
-        spectral.bottom_weights(grid, gf, tally, p, weight)
+        spectral.bottom_weights(grid, gf, ps, p, weight)
     for j in range(n):
         tau[j] = mf[medium.plane_tau + j * medium.n_planes + bottom_plane]
     z = mf[medium.plane_z + bottom_plane]

@@ -40,13 +40,18 @@ SKY_MAP = 2              # a tabulated radiance map, piecewise constant on its c
 SKY_HARRISON_COOMBES = 3  # Harrison & Coombes (1988) clear sky; a fine map as the proposal
 SKY_MAP_COSINE = 4       # a map sampled cosine-weighted, each photon weighted by its cell's L
 
+# Collision channels (kernel/channels/).
+CHANNEL_ELASTIC = 0
+
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0
 BUDGET_WATER_LEAVING = 1
 BUDGET_BOTTOM = 2
 BUDGET_LOST_BELOW = 3
 BUDGET_TRUNCATED = 4     # weight still alive when a photon hit the max_events safety limit
-BUDGET_LAYERS = 5
+BUDGET_SHIFTED_OUT = 5   # weight an inelastic process took from this wavelength
+BUDGET_SHIFTED_IN = 6    # weight an inelastic process gave to this wavelength
+BUDGET_LAYERS = 7
 
 # Water flux tally columns.
 FLUX_ED = 0

@@ -8,10 +8,12 @@ layer_c, ...) is the offset of that table in the pool. So every scene, whatever 
 layers, tables or tally depths, has the same types, and each compiled function is compiled once
 (MC/DC's records plus one flat data array, CEMeNT-PSAAP/MCDC).
 
-The packet is a record too (PACKET); the split stack holds rows of the same dtype.
+The packet is a record too (PACKET) with its spectral state in a float row of its own
+(packet_state_size: kernel/spectral.py); the split stack holds rows of both. One event's
+scratch (work_size) is a third row, kept by no packet.
 
-The tallies of one batch are one flat float64 row; the GRID record holds where each score's
-array starts (flux, radiance, local, cap, budget) and its shape.
+The tallies of one batch are one flat float64 row of scores and nothing else; the GRID record
+holds where each score's array starts (flux, radiance, local, cap, budget) and its shape.
 
 Nothing here is compiled: the packers (oceanmc/scene/) fill these, the kernel reads them.
 """
@@ -43,23 +45,26 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
-#               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1), mix_comp, mix_at: the terms
-#               of each layer's volume scattering functions, all wavelengths side by side
-#               (scene/medium.py scattering_terms, kernel/spectral.py)
+#               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1),
+#               mix_comp, mix_at: the terms of each layer's volume scattering functions, all
+#               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py)
+#   collision channels (kernel/channels/): float pool channel_b (n_layers x n_channels x n_wl:
+#               each channel's scattering coefficient, adding up to the layer's b); int pool
+#               channel_model (n_channels: registry.CHANNEL ids)
 MEDIUM = _record(
-    "n_planes", "n_layers", "n_wl", "n_comps", "up_cos",
+    "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
     "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b",
     "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
     "tab_psi", "tab_q", "tab_cdf", "mix_coef",
     "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
     "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr", "mix_comp",
-    "mix_at",
-    ints=("n_planes", "n_layers", "n_wl", "n_comps", "plane_z", "plane_tau", "layer_c",
-          "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
+    "mix_at", "channel_b", "channel_model",
+    ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "plane_z", "plane_tau",
+          "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
           "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
           "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
           "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
-          "mix_comp", "mix_at"))
+          "mix_comp", "mix_at", "channel_b", "channel_model"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
@@ -87,23 +92,20 @@ SKY = _record(
 #               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
 #               spectral scenes: source_q (2 x n_wl: sun, sky), bottom_q (n_wl)
-#   tally row:  spectral scenes first: the packet's spectral state (kernel/spectral.py: K, G,
-#               F (n_wl each), D, beta (n_wl)); every scene: the local estimates' scratch
-#               (kernel/local_estimate.py: weight, tau, phase (n_wl each)), and their scores,
-#               local ((n_depths + 1) x n_dirs x n_wl) and cap ((n_depths + 1) x n_wl); then,
-#               from `scores` on, flux (n_levels x 4), radiance (n_levels x n_theta_cols x
+#   tally row:  the local estimates' scores, local ((n_depths + 1) x n_dirs x n_wl) and cap
+#               ((n_depths + 1) x n_wl); then, from `scores` on, flux (n_levels x 4), radiance (n_levels x n_theta_cols x
 #               n_phi_cols), budget (n_budget), each score with its n_wl wavelengths side by
 #               side: the offsets below are those of one wavelength's layout, and the score at
 #               offset i of wavelength j lies at scores + (i - scores) n_wl + j (tally.py
 #               spectral_at: the same address when n_wl = 1)
 GRID = _record(
-    "n_wl", "scores", "spectral", "scratch", "source_q", "bottom_q",
+    "n_wl", "scores", "source_q", "bottom_q",
     "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
     "n_lookup", "theta_cols", "phi_cols",
     "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
     "theta_lookup", "theta_is_cap",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "scores", "spectral", "scratch", "source_q", "bottom_q",
+    ints=("n_wl", "scores", "source_q", "bottom_q",
           "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
           "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
           "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",
@@ -138,6 +140,20 @@ PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength", "refer
 
 # Rows on the split stack of one batch (kernel/transport.py)
 SPLIT_STACK_ROWS = 64
+
+
+def packet_state_size(n_wl: int) -> int:
+    """Floats of a packet's spectral state (kernel/spectral.py state: K, G and F at the last
+    settle, n_wl each, then the free path D since it); one wavelength keeps none, but the row
+    is never empty."""
+    return 3 * n_wl + 1 if n_wl > 1 else 1
+
+
+def work_size(n_wl: int) -> int:
+    """Floats of one event's scratch: a collision's volume scattering function at every
+    wavelength (kernel/spectral.py), then a local estimate's weight, optical depth and phase
+    function at every wavelength (kernel/local_estimate.py)."""
+    return 4 * n_wl
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

@@ -47,9 +47,19 @@ it acts on, since every wavelength's weight is divided by the same survival prob
 hero's weight alone, walks were half as long but a blue wavelength carried by a red hero lost
 roulette early: 30 times the variance at 400 nm in a Case-1 water.)
 
-The packet's spectral state lives at the head of the batch's tally row (grid.spectral; not a
-tally, the results skip it), so every scorer reaches it without another argument: K (n), G (n),
-F at the last settle (n), D, then scratch for one collision's beta_j (n).
+The packet's spectral state is a float row of its own, `ps` (records.packet_state_size), which
+travels with the PACKET record (the split stack holds rows of both): K (n), G (n), F at the last
+settle (n), D. One collision's beta_j (n) is scratch in the batch's `work` row, which no packet
+keeps.
+
+Splitting (transport.split) divides p.w and F at the last settle by the number of copies, and
+each copy carries the same K, G and D: the walk has no memory, so each is an unbiased copy at
+every wavelength. The analog walk draws the hero's absorption at a collision, its reflection at
+the surface and at the bottom (the other wavelengths keep their ratios to the hero's weight:
+one-sample MIS over analog walks); attenuation in layers that scatter at no wavelength stays
+exact. Scattering biased toward straight up (upward.py) is one more sampling technique per
+wavelength: each wavelength's walk would draw directions from the same mixture of its own phase
+function and the upward cone (scatter_weights).
 """
 import math
 
@@ -58,6 +68,7 @@ from .models import BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, PHASE_TABUL
 from .phase import dispatch as phase
 from .phase import tabulated
 from .rng import uniform
+from .packet import free_path_at, weights
 from .tally import spectral_at
 
 # a K_j past this settles the packet (its exponentials bring the K back near 1), long before
@@ -66,64 +77,53 @@ K_BOUND = 1e100
 
 
 @kernel
-def weights(grid, tally):
-    """Views of the packet's spectral state: K, G and F at the last settle (n_wl each). The
-    loops over wavelengths index these views from 0, which lets LLVM vectorise them (an offset
-    index of unknown sign costs a wraparound test per element; measured 2.5x slower)."""
-    n = grid.n_wl
-    m = grid.spectral
-    return tally[m:m + n], tally[m + n:m + 2 * n], tally[m + 2 * n:m + 3 * n]
-
-
-@kernel
-def start(grid, gf, tally, p, from_sky, rng):
+def start(grid, gf, ps, p, from_sky, rng):
     """A new photon: its wavelengths' shares of the source (sun or sky: grid.source_q) and its
     hero wavelength, drawn uniformly (the reference wavelength starts as the hero)."""
     n = grid.n_wl
-    k, g, last = weights(grid, tally)
+    k, g, last = weights(grid, ps)
     row = grid.source_q + (n if from_sky else 0)
     share = gf[row:row + n]
     for j in range(n):
         k[j] = 1.0
         g[j] = share[j]
         last[j] = 0.0
-    tally[grid.spectral + 3 * n] = 0.0
+    ps[free_path_at(grid)] = 0.0
     p.wavelength = min(n - 1, int(uniform(rng) * n))
     p.reference = p.wavelength
 
 
 @kernel
-def carry(grid, tally, p):
+def carry(grid, ps, p):
     """The packet's weights as they are now are what it carries on in its layer (it has just
     entered the water, or been reflected by the surface or the bottom)."""
-    _, g, last = weights(grid, tally)
+    _, g, last = weights(grid, ps)
     w = p.w
     for j in range(grid.n_wl):
         last[j] = w * g[j]
 
 
 @internal
-def fly(medium, mf, grid, tally, p, layer, dist):
+def fly(medium, mf, grid, ps, p, layer, dist):
     """A free path of length dist in a scattering layer, to a collision or a plane: its
     exponentials wait for the next settle (D), except the reference wavelength's
     exp(-(c_r - c_h) dist), which p.w takes at once (so that p.w follows F_r; see scatter;
     settle gives G_j exp(-(c_j - c_r) D) to match)."""
-    tally[grid.spectral + 3 * grid.n_wl] += dist
+    ps[free_path_at(grid)] += dist
     if p.reference != p.wavelength:
         row = medium.layer_c + layer * grid.n_wl
         p.w *= math.exp(-(mf[row + p.reference] - mf[row + p.wavelength]) * dist)
 
 
 @kernel
-def settle(medium, mf, grid, tally, p, layer):
+def settle(medium, mf, grid, tally, ps, p, layer):
     """Applies the deferred exponentials (K_j times exp(-(c_j - c_h) D); G_j times
     exp(-(c_j - c_r) D), as p.w took the reference wavelength's share in fly), scales K to
     mean 1 and G to G_r = 1 (so p.w is F_r, and p.w G_j is F_j), and adds to the layer's
     absorption what each wavelength lost since the last settle."""
     n = grid.n_wl
-    k, g, last = weights(grid, tally)
-    at = grid.spectral + 3 * n
-    dist = tally[at]
+    k, g, last = weights(grid, ps)
+    dist = ps[free_path_at(grid)]
     row = medium.layer_c + layer * n
     c = mf[row:row + n]
     r = p.reference
@@ -134,7 +134,7 @@ def settle(medium, mf, grid, tally, p, layer):
             factor = math.exp(-(c[j] - c_h) * dist)
             k[j] *= factor
             g[j] *= factor * shift
-        tally[at] = 0.0
+        ps[free_path_at(grid)] = 0.0
     total = 0.0
     for j in range(n):
         total += k[j]
@@ -207,7 +207,7 @@ def phase_values(medium, mf, mi, layer, cos_psi, out):
 
 
 @kernel
-def collision_weights(medium, mf, grid, tally, p, layer, weight):
+def collision_weights(medium, mf, grid, ps, p, layer, weight):
     """What a collision of the packet sends at each wavelength, as a local estimate needs it,
     without settling: with e_j = exp(-(c_j - c_h) D) the deferred factors, a settle would make
     F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w took of the
@@ -216,11 +216,11 @@ def collision_weights(medium, mf, grid, tally, p, layer, weight):
     G_j e_j b_j / mean_k(K_k e_k c_k) (the mean of K e cancels; one wavelength: w b / c, the
     implicit-capture weight)."""
     n = grid.n_wl
-    k, g, _ = weights(grid, tally)
+    k, g, _ = weights(grid, ps)
     row = medium.layer_c + layer * n
     c = mf[row:row + n]
     albedo = mf[medium.layer_albedo + layer * n:medium.layer_albedo + layer * n + n]
-    dist = tally[grid.spectral + 3 * n]
+    dist = ps[free_path_at(grid)]
     c_h = c[p.wavelength]
     for j in range(n):
         weight[j] = math.exp(-(c[j] - c_h) * dist)
@@ -233,12 +233,12 @@ def collision_weights(medium, mf, grid, tally, p, layer, weight):
 
 
 @kernel
-def bottom_weights(grid, gf, tally, p, weight):
+def bottom_weights(grid, gf, ps, p, weight):
     """What a bottom reflection sends at each wavelength, as a local estimate needs it (the
     packet settled on reaching the bottom plane): weight_j = p.w G_j bottom_q_j, times the
     BRDF the estimate evaluates."""
     n = grid.n_wl
-    _, g, _ = weights(grid, tally)
+    _, g, _ = weights(grid, ps)
     share = gf[grid.bottom_q:grid.bottom_q + n]
     w = p.w
     for j in range(n):
@@ -246,67 +246,92 @@ def bottom_weights(grid, gf, tally, p, weight):
 
 
 @internal
-def scatter(medium, mf, mi, grid, tally, p, layer, u_pick, u):
-    """A collision (p.w already times the hero's albedo): the hero's new direction, sampled from
-    its phase mixture with u_pick (the component) and u (the angle), then per wavelength the
-    factors of F_j = p.w G_j / mean K: beta_j / beta_h (the albedo times the phase function
-    times the free-path density, relative to the hero's) and K_j times (c_j p_j) / (c_h p_h) =
+def scatter_weights(medium, mf, mi, grid, tally, ps, work, p, layer, cos_s, angle, psi_s,
+                    node_s, keep, cone_density):
+    """A collision (p.w already times the hero's albedo) that turned the hero by psi (cos_s,
+    angle; psi_s, node_s: the table node it was sampled at, or -1): per wavelength the factors
+    of F_j = p.w G_j / mean K: beta_j / beta_h (the albedo times the phase function times the
+    free-path density, relative to the hero's) and K_j times (c_j p_j) / (c_h p_h) =
     (beta_j c_j / b_j) / (beta_h c_h / b_h). The factor beta_j / beta_h is split as
     beta_r / beta_h on p.w and beta_j / beta_r on G_j, r the packet's reference wavelength (the
     heaviest at the last roulette test), so p.w follows the weight that decides roulette rather
     than the hero's: a red hero's p.w would fall below the threshold at every collision while
     blue wavelengths still carry the packet, each time paying a settle (measured: 13 settles
-    per photon, Chl 1 deep). Returns cos(psi)."""
+    per photon, Chl 1 deep).
+
+    Scattering biased toward straight up (upward.py; keep = 1 - f < 1): every wavelength's walk
+    would draw its direction from (1 - f) p_j + f g (g the cone's density, inside the cone), so
+    its density is q_j = keep p_j + d, d = f g inside the cone (cone_density) and 0 outside.
+    The path's value keeps b_j p_j: p.w takes beta_r / (keep beta_h + s b_h d) (the hero's p/q
+    times beta_r / beta_h) and K_j the factor c_j q_j / (c_h q_h) = (keep beta_j c_j / b_j +
+    s c_j d) / (keep beta_h c_h / b_h + s c_h d), s = 2 pi sin(psi) the units of beta."""
     h = p.wavelength
-    k_s = phase.pick(medium, mf, mi, layer, h, u_pick)
-    cos_s, angle, psi_s, node_s = phase.sample_angle(medium, mf, mi, k_s, u)
     n = grid.n_wl
-    k, g, _ = weights(grid, tally)
-    at = grid.spectral + 3 * n + 1
-    beta = tally[at:at + n]
+    k, g, _ = weights(grid, ps)
+    beta = work[:n]
     volume_scattering(medium, mf, mi, layer, cos_s, angle, psi_s, node_s, beta)
     row = medium.layer_c_over_b + layer * n
     c_over_b = mf[row:row + n]
     r = p.reference if beta[p.reference] > 0.0 else h
-    per_ref = 1.0 / beta[r]
-    per_k = 1.0 / (beta[h] * c_over_b[h])
-    p.w *= beta[r] / beta[h]
     # a count, not a max, of the K past the bound: an integer sum vectorises, a float max
     # does not (measured: the loop took twice as long with the max)
     over = 0
-    for j in range(n):
-        g[j] *= beta[j] * per_ref
-        k_j = k[j] * (beta[j] * c_over_b[j] * per_k)
-        k[j] = k_j
-        over += k_j > K_BOUND
+    if keep == 1.0:
+        per_ref = 1.0 / beta[r]
+        per_k = 1.0 / (beta[h] * c_over_b[h])
+        p.w *= beta[r] / beta[h]
+        for j in range(n):
+            g[j] *= beta[j] * per_ref
+            k_j = k[j] * (beta[j] * c_over_b[j] * per_k)
+            k[j] = k_j
+            over += k_j > K_BOUND
+    else:
+        if beta[r] <= 0.0:   # a direction from the cone that the hero's phase function lacks
+            for j in range(n):
+                if beta[j] > beta[r]:
+                    r = j
+            if beta[r] <= 0.0:   # no wavelength scatters into it: the path ends here
+                p.w = 0.0
+                return
+        row = medium.layer_c + layer * n
+        c = mf[row:row + n]
+        s_d = 2.0 * math.pi * math.sin(angle) * cone_density
+        per_k = 1.0 / (keep * beta[h] * c_over_b[h] + s_d * c[h])
+        per_ref = 1.0 / beta[r]
+        p.w *= beta[r] * c_over_b[h] * per_k
+        for j in range(n):
+            g[j] *= beta[j] * per_ref
+            k_j = k[j] * ((keep * beta[j] * c_over_b[j] + s_d * c[j]) * per_k)
+            k[j] = k_j
+            over += k_j > K_BOUND
     if over > 0:
-        settle(medium, mf, grid, tally, p, layer)
-    return cos_s
+        settle(medium, mf, grid, tally, ps, p, layer)
 
 
 @kernel
-def lose(grid, tally, layer):
-    """The packet lost roulette in `layer`: what it carried at its last settle stays there."""
-    _, _, last = weights(grid, tally)
+def lose(grid, tally, ps, layer):
+    """The packet lost roulette, or the analog walk's absorption draw, in `layer`: what it
+    carried at its last settle stays there (every collision since then was in that layer)."""
+    _, _, last = weights(grid, ps)
     absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(grid.n_wl):
         tally[absorbed + j] += last[j]
 
 
 @kernel
-def attenuate(medium, mf, grid, tally, p, layer, dist):
+def attenuate(medium, mf, grid, tally, ps, p, layer, dist):
     """A layer that scatters at no wavelength: wavelength j keeps exp(-c_j dist) (the plane's
     settle books the rest as absorbed); dist = inf (down an infinitely deep layer): all of it
     is absorbed there, or lost below where c_j = 0. Returns whether the packet is gone."""
     n = grid.n_wl
-    _, g, _ = weights(grid, tally)
+    _, g, _ = weights(grid, ps)
     row = medium.layer_c + layer * n
     c = mf[row:row + n]
     if dist < math.inf:
         for j in range(n):
             g[j] *= math.exp(-c[j] * dist)
         return False
-    settle(medium, mf, grid, tally, p, layer)
+    settle(medium, mf, grid, tally, ps, p, layer)
     absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     lost = spectral_at(grid, grid.budget + BUDGET_LOST_BELOW)
     w = p.w
@@ -316,11 +341,12 @@ def attenuate(medium, mf, grid, tally, p, layer, dist):
 
 
 @kernel
-def reflect(grid, gf, tally, p, rho):
-    """The bottom reflects rho (the sampled BRDF's weight, on p.w) times wavelength j's share
-    bottom_q_j of the reflectance (on G_j); the rest is absorbed by the bottom."""
+def reflect(grid, gf, tally, ps, p, rho):
+    """The bottom reflects rho (the sampled BRDF's weight, on p.w; 1 after the analog walk's
+    reflection draw) times wavelength j's share bottom_q_j of the reflectance (on G_j); the
+    rest is absorbed by the bottom."""
     n = grid.n_wl
-    _, g, _ = weights(grid, tally)
+    _, g, _ = weights(grid, ps)
     share = gf[grid.bottom_q:grid.bottom_q + n]
     absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
     w = p.w
@@ -328,23 +354,35 @@ def reflect(grid, gf, tally, p, rho):
         tally[absorbed + j] += w * g[j] * (1.0 - rho * share[j])
         g[j] *= share[j]
     p.w *= rho
-    carry(grid, tally, p)
+    carry(grid, ps, p)
 
 
 @kernel
-def survives_roulette(medium, mf, ctrl, grid, tally, p, layer, rng):
+def absorb_at_bottom(grid, tally, ps, p):
+    """The analog walk's bottom absorbs the packet (which settled on the bottom plane): every
+    wavelength's weight."""
+    _, g, _ = weights(grid, ps)
+    absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
+    w = p.w
+    for j in range(grid.n_wl):
+        tally[absorbed + j] += w * g[j]
+
+
+@kernel
+def survives_roulette(medium, mf, ctrl, grid, tally, ps, p, layer, rng):
     """Roulette after a collision, on the largest wavelength weight max_j F_j (as transport's
     survives_roulette on p.w): a packet with p.w at or above the threshold goes on untested;
     below it, the packet settles and p.w becomes max_j F_j (G_j / max G, so F is unchanged),
     which then plays roulette; the heaviest wavelength becomes the reference that p.w follows
     (scatter). So the exponentials of a settle are paid only when the packet's heaviest
     wavelength has lost weight, and a hero wavelength that is absorbed fast does not end a path
-    that other wavelengths still carry. The loser's weights stay in the layer (lose)."""
-    if p.w >= ctrl.roulette_weight:
+    that other wavelengths still carry. The loser's weights stay in the layer (lose). The
+    analog walk plays no roulette."""
+    if ctrl.analog or p.w >= ctrl.roulette_weight:
         return True
-    settle(medium, mf, grid, tally, p, layer)
+    settle(medium, mf, grid, tally, ps, p, layer)
     n = grid.n_wl
-    _, g, _ = weights(grid, tally)
+    _, g, _ = weights(grid, ps)
     top = 0.0
     for j in range(n):
         if g[j] > top:
@@ -360,5 +398,5 @@ def survives_roulette(medium, mf, ctrl, grid, tally, p, layer, rng):
     if uniform(rng) < ctrl.roulette_survival:
         p.w /= ctrl.roulette_survival
         return True
-    lose(grid, tally, layer)
+    lose(grid, tally, ps, layer)
     return False

@@ -17,20 +17,14 @@ import math
 
 from .compile import kernel
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
+from .search import interval
+from .packet import weights
 
 
 @kernel
 def theta_band(uz, mu_edges):
     """Index i with mu_edges[i] >= uz > mu_edges[i + 1] (mu_edges falls from 1 to -1)."""
-    lo = 0
-    hi = mu_edges.shape[0] - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if uz <= mu_edges[mid]:
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    return interval(mu_edges, 0, 0, mu_edges.shape[0] - 1, uz, falling=True)
 
 
 @kernel
@@ -113,22 +107,24 @@ def spectral_at(grid, index):
 
 
 @kernel
-def score(grid, tally, index, w):
+def score(grid, tally, ps, index, w):
     """Adds weight w to score `index` (its offset in one wavelength's layout), and in a
-    spectral scene w times each wavelength's share q (kernel/spectral.py) to that wavelength's."""
+    spectral scene w times each wavelength's share q of the packet (ps: its spectral state,
+    kernel/packet.py) to that wavelength's."""
     if grid.n_wl == 1:
         tally[index] += w
         return
-    q = grid.spectral + grid.n_wl
+    _, q, _ = weights(grid, ps)
     at = spectral_at(grid, index)
     for j in range(grid.n_wl):
-        tally[at + j] += w * tally[q + j]
+        tally[at + j] += w * q[j]
 
 
 @kernel
-def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
+def score_crossing(grid, gf, gi, tally, ps, level, w, ux, uy, uz, beam):
     """A crossing of tally level `level` (an in-water depth, or one of the air levels after
-    them); beam: the packet is still part of the collimated solar beam."""
+    them) by a packet of spectral state ps; beam: the packet is still part of the collimated
+    solar beam."""
     w_over_mu = w * inverse_mu(uz, grid.mu_cut, beam)
     at = grid.flux + 4 * level
     plane = at + (FLUX_ED if uz > 0.0 else FLUX_EU)
@@ -144,14 +140,14 @@ def score_crossing(grid, gf, gi, tally, level, w, ux, uy, uz, beam):
         if quad >= 0:
             tally[quad] += w_over_mu
         return
-    q = grid.spectral + grid.n_wl
+    _, q, _ = weights(grid, ps)
     plane = spectral_at(grid, plane)
     scalar = spectral_at(grid, scalar)
     for j in range(grid.n_wl):
-        share = tally[q + j]
+        share = q[j]
         tally[plane + j] += w * share
         tally[scalar + j] += w_over_mu * share
     if quad >= 0:
         quad = spectral_at(grid, quad)
         for j in range(grid.n_wl):
-            tally[quad + j] += w_over_mu * tally[q + j]
+            tally[quad + j] += w_over_mu * q[j]

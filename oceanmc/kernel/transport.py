@@ -6,8 +6,9 @@ trace_batch's event loop (move to the next event, then handle it, as MC/DC's loo
 free_flight (to the next collision or plane), collide, cross_plane, and on the surface
 leave_or_reflect, on the bottom reflect_at_bottom, after either after_reflection; a packet from
 the air meets the surface in enter_from_air. Only trace_batch sees the whole scene; each event
-takes the component records and pools it needs (kernel/records.py) and the packet, a PACKET
-record that it updates in place. The event functions carry LLVM's alwaysinline attribute
+takes the component records and pools it needs (kernel/records.py) and the packet (kernel/
+packet.py: a PACKET record p and its spectral state ps), which it updates in place. A
+collision that scatters runs one of the scene's collision channels (kernel/channels/). The event functions carry LLVM's alwaysinline attribute
 (kernel/compile.py): compiled once each, they are merged into the loop by LLVM, not copied by
 Numba.
 
@@ -18,7 +19,8 @@ light from the water: the leaving part w (1 - R) is scored, and the packet goes 
 with probability R and weight w), weight times rho_dh at the bottom, exact exponential
 attenuation in layers that do not scatter, and unbiased Russian roulette below
 roulette_weight; optionally, scattering biased toward straight up (upward.py) and splitting of
-heavy packets. Analog mode decides each of these with a random draw instead. Either way every
+heavy packets. Analog mode decides each of these with a random draw instead (in a spectral walk,
+for the hero wavelength; kernel/spectral.py). Either way every
 quantity has the same expectation; only the variance differs.
 
 A spectral scene traces all its wavelengths in one history (kernel/spectral.py): a hero
@@ -26,17 +28,17 @@ wavelength per photon (p.wavelength) samples the path, and every wavelength's we
 the events below call spectral.* only where grid.n_wl > 1.
 
 Every draw comes from the batch's own stream (kernel/rng.py), passed down as `rng`; it is
-kept apart from the PACKET record, so split copies do not copy it.
+kept apart from the packet, so split copies do not copy it. One event's scratch is the batch's
+`work` row, kept by no packet.
 """
 import math
 
-from . import local_estimate, spectral, upward
+from . import local_estimate, packet, spectral
 from .brdf import dispatch as brdf
+from .channels import dispatch as channels
 from .compile import batch, internal
-from .geometry import turn
 from .models import (BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, BUDGET_SURFACE_REFLECTION,
                      BUDGET_TRUNCATED, BUDGET_WATER_LEAVING)
-from .phase import dispatch as phase
 from .rng import uniform
 from .sources import sky_direction
 from .surface import dispatch as surface_bsdf
@@ -58,32 +60,6 @@ def exponential(rng):
 
 
 @internal
-def launch(p, w, ux, uy, uz, beam):
-    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz);
-    beam: it belongs to the collimated solar beam."""
-    p.z = 0.0
-    p.seg = 0
-    p.w = w
-    p.ux = ux
-    p.uy = uy
-    p.uz = uz
-    p.beam = 1 if beam else 0
-
-
-@internal
-def copy_packet(dst, src):
-    dst.z = src.z
-    dst.w = src.w
-    dst.ux = src.ux
-    dst.uy = src.uy
-    dst.uz = src.uz
-    dst.seg = src.seg
-    dst.beam = src.beam
-    dst.wavelength = src.wavelength
-    dst.reference = src.reference
-
-
-@internal
 def survives_roulette(ctrl, p, rng):
     """Below the threshold a packet survives with probability s and then carries w/s, so the
     expected weight is unchanged."""
@@ -96,18 +72,19 @@ def survives_roulette(ctrl, p, rng):
 
 
 @internal
-def split(ctrl, stack, n_stacked, p):
+def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
     """Splitting by weight: a packet heavier than split_weight becomes k = floor(w /
     split_weight) + 1 packets of weight w / k, each lighter than split_weight, that go on
     independently from the same state (the walk has no memory, so each is an unbiased copy;
     Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2). All but one wait on the stack, as many as
-    it has room for (fewer, heavier copies are as unbiased). Returns the new stack height."""
+    it has room for (fewer, heavier copies are as unbiased); every copy carries the packet's
+    spectral state. Returns the new stack height."""
     copies = min(int(p.w / ctrl.split_weight) + 1, stack.shape[0] - n_stacked + 1)
     if copies <= 1:
         return n_stacked
-    p.w /= copies
+    packet.divide(grid, p, ps, copies)
     for _ in range(copies - 1):
-        copy_packet(stack[n_stacked], p)
+        packet.copy(grid, stack[n_stacked], stack_ps[n_stacked], p, ps)
         n_stacked += 1
     return n_stacked
 
@@ -124,13 +101,13 @@ def facet_walk(surface, p, rng):
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
+def enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
     air = grid.air_level
     w = p.w
-    score_crossing(grid, gf, gi, tally, air, w, p.ux, p.uy, p.uz, p.beam)
+    score_crossing(grid, gf, gi, tally, ps, air, w, p.ux, p.uy, p.uz, p.beam)
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
@@ -144,20 +121,20 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
         w_reflected = w * r
         p.w = w * (1.0 - r)
     if w_reflected > 0.0:
-        score_crossing(grid, gf, gi, tally, air, w_reflected, rx, ry, rz, p.beam)
-        score(grid, tally, grid.budget + BUDGET_SURFACE_REFLECTION, w_reflected)
+        score_crossing(grid, gf, gi, tally, ps, air, w_reflected, rx, ry, rz, p.beam)
+        score(grid, tally, ps, grid.budget + BUDGET_SURFACE_REFLECTION, w_reflected)
     if reflected or p.w <= 0.0:
         return False
     p.ux = tx
     p.uy = ty
     p.uz = tz
     if grid.surface_level >= 0:
-        score_crossing(grid, gf, gi, tally, grid.surface_level, p.w, tx, ty, tz, p.beam)
+        score_crossing(grid, gf, gi, tally, ps, grid.surface_level, p.w, tx, ty, tz, p.beam)
     return True
 
 
 @internal
-def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
+def free_flight(medium, mf, mi, ctrl, grid, tally, ps, p, tau, rng):
     """Moves the packet through its segment with tau optical depths left to its next
     collision: (FLIGHT_COLLISION, layer, 0) at a collision, (FLIGHT_PLANE, plane, tau left) on
     reaching the plane ahead, or (FLIGHT_GONE, -1, 0) when a layer that does not scatter
@@ -184,13 +161,13 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
         if s < dist:
             p.z += s * uz
             if grid.n_wl > 1:
-                spectral.fly(medium, mf, grid, tally, p, layer, s)
+                spectral.fly(medium, mf, grid, ps, p, layer, s)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
         if grid.n_wl > 1 and dist < math.inf:
-            spectral.fly(medium, mf, grid, tally, p, layer, dist)
+            spectral.fly(medium, mf, grid, ps, p, layer, dist)
     elif grid.n_wl > 1:
-        if spectral.attenuate(medium, mf, grid, tally, p, layer, dist):
+        if spectral.attenuate(medium, mf, grid, tally, ps, p, layer, dist):
             return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
         # no scattering and no plane ahead: down an infinitely deep clear layer, or level
@@ -206,66 +183,57 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, p, tau, rng):
             tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
             p.w *= transmitted
     if grid.n_wl > 1:
-        spectral.settle(medium, mf, grid, tally, p, layer)
+        spectral.settle(medium, mf, grid, tally, ps, p, layer)
     if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
-        score(grid, tally, budget + BUDGET_LOST_BELOW, p.w)
+        score(grid, tally, ps, budget + BUDGET_LOST_BELOW, p.w)
         return FLIGHT_GONE, -1, 0.0
     p.z = mf[medium.plane_z + target]
     return FLIGHT_PLANE, target, tau
 
 
 @internal
-def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, p, layer, events, rng):
+def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, ps, work, p, layer,
+            events, rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
-    a new direction, roulette. Returns (alive, optical depth to the next collision)."""
+    one of the scene's collision channels (kernel/channels/) by its share of the scattering,
+    roulette. Returns (alive, optical depth to the next collision)."""
     albedo = mf[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
     if est.directions_on or est.cap_on:   # (a spectral walk settles there: p.w may change)
-        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, p,
-                                    layer, p.w * albedo, rng)
+        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps,
+                                    work, p, layer, p.w * albedo, rng)
     w = p.w
     budget = grid.budget
     if ctrl.analog:
         if uniform(rng) >= albedo:
-            tally[budget + BUDGET_LAYERS + layer] += w
+            if grid.n_wl > 1:
+                spectral.lose(grid, tally, ps, layer)
+            else:
+                tally[budget + BUDGET_LAYERS + layer] += w
             return False, 0.0
     else:
         scattered = w * albedo
         if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
             tally[budget + BUDGET_LAYERS + layer] += w - scattered
-        w = scattered
-    if ctrl.upward:
-        w, ux, uy, uz = upward.scatter(medium, mf, mi, layer, w, p.ux, p.uy, p.uz, rng)
-    else:
-        u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
-        if grid.n_wl > 1:
-            p.w = w
-            cos_s = spectral.scatter(medium, mf, mi, grid, tally, p, layer, u_pick,
-                                     uniform(rng))
-            w = p.w
-        else:
-            cos_s = phase.sample_cos(medium, mf, mi, layer, p.wavelength, u_pick, uniform(rng))
-        ux, uy, uz = turn(p.ux, p.uy, p.uz, cos_s, uniform(rng))
-    p.w = w
-    p.ux = ux
-    p.uy = uy
-    p.uz = uz
+        p.w = scattered
+    channel = channels.choose(medium, mf, layer, p.wavelength, rng)
+    channels.scatter(channel, medium, mf, mi, ctrl, grid, tally, ps, work, p, layer, rng)
     p.beam = 0
     tau = exponential(rng)
     if grid.n_wl > 1:
-        if not spectral.survives_roulette(medium, mf, ctrl, grid, tally, p, layer, rng):
+        if not spectral.survives_roulette(medium, mf, ctrl, grid, tally, ps, p, layer, rng):
             return False, tau
     elif not survives_roulette(ctrl, p, rng):
         return False, tau
     if events >= ctrl.max_events:
         if grid.n_wl > 1:
-            spectral.settle(medium, mf, grid, tally, p, layer)
-        score(grid, tally, budget + BUDGET_TRUNCATED, p.w)
+            spectral.settle(medium, mf, grid, tally, ps, p, layer)
+        score(grid, tally, ps, budget + BUDGET_TRUNCATED, p.w)
         return False, tau
     return True, tau
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
+def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -284,9 +252,9 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
         goes_on = r > 0.0 and (r >= 1.0 or uniform(rng) < r)
     if leaving > 0.0:
         air = grid.air_level
-        score_crossing(grid, gf, gi, tally, air, leaving, tx, ty, tz, p.beam)
-        score_crossing(grid, gf, gi, tally, air + 1, leaving, tx, ty, tz, p.beam)
-        score(grid, tally, grid.budget + BUDGET_WATER_LEAVING, leaving)
+        score_crossing(grid, gf, gi, tally, ps, air, leaving, tx, ty, tz, p.beam)
+        score_crossing(grid, gf, gi, tally, ps, air + 1, leaving, tx, ty, tz, p.beam)
+        score(grid, tally, ps, grid.budget + BUDGET_WATER_LEAVING, leaving)
     if not goes_on:
         return False
     p.ux = rx
@@ -294,23 +262,23 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng):
     p.uz = rz
     p.seg = 0
     if grid.n_wl > 1:
-        spectral.carry(grid, tally, p)
+        spectral.carry(grid, ps, p)
     return True
 
 
 @internal
-def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, p,
-                      rng):
+def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, ps,
+                      work, p, rng):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
     budget = grid.budget
     if not bottom.reflects:  # black (an infinitely deep bottom is never met)
-        score(grid, tally, budget + BUDGET_BOTTOM, p.w)
+        score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)
         return False
     if est.directions_on or est.cap_on:
         local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
-                                 p, rng)
+                                 ps, work, p, rng)
     ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, uniform(rng),
                                    uniform(rng))
     p.ux = ux
@@ -319,10 +287,15 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
     p.beam = 1 if (p.beam != 0 and bottom.mirror != 0) else 0
     if ctrl.analog:
         if uniform(rng) >= rho:
-            tally[budget + BUDGET_BOTTOM] += p.w
+            if grid.n_wl > 1:
+                spectral.absorb_at_bottom(grid, tally, ps, p)
+            else:
+                tally[budget + BUDGET_BOTTOM] += p.w
             return False
+        if grid.n_wl > 1:
+            spectral.reflect(grid, gf, tally, ps, p, 1.0)
     elif grid.n_wl > 1:
-        spectral.reflect(grid, gf, tally, p, rho)
+        spectral.reflect(grid, gf, tally, ps, p, rho)
     else:
         tally[budget + BUDGET_BOTTOM] += p.w * (1.0 - rho)
         p.w *= rho
@@ -331,13 +304,13 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
 
 
 @internal
-def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
+def cross_plane(medium, mi, grid, gf, gi, tally, ps, p, target):
     """The packet is on plane `target`: scored if the plane is a tally level; returns what the
     plane is (PLANE_SURFACE, PLANE_BOTTOM, or PLANE_INSIDE, where the packet has gone on into
     the next segment) and the plane's tally level (-1: none)."""
     level = mi[medium.plane_tally + target]
     if level >= 0:
-        score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, gf, gi, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if target == 0:
         return PLANE_SURFACE, level
     if target == medium.n_planes - 1:
@@ -347,16 +320,16 @@ def cross_plane(medium, mi, grid, gf, gi, tally, p, target):
 
 
 @internal
-def after_reflection(medium, mf, mi, ctrl, grid, gf, gi, tally, stack, n_stacked, p, level,
-                     rng):
+def after_reflection(medium, mf, mi, ctrl, grid, gf, gi, tally, ps, stack, stack_ps, n_stacked,
+                     p, level, rng):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
-        score_crossing(grid, gf, gi, tally, level, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, gf, gi, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
-        n_stacked = split(ctrl, stack, n_stacked, p)
+        n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
     if grid.n_wl > 1:
-        return spectral.survives_roulette(medium, mf, ctrl, grid, tally, p,
+        return spectral.survives_roulette(medium, mf, ctrl, grid, tally, ps, p,
                                           mi[medium.segment_layer + p.seg], rng), n_stacked
     return survives_roulette(ctrl, p, rng), n_stacked
 
@@ -364,7 +337,7 @@ def after_reflection(medium, mf, mi, ctrl, grid, gf, gi, tally, stack, n_stacked
 @batch
 def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
                 est_row, ef, ei, ctrl_row, n_photons, start, work_budget, rng, beam_in, tally,
-                packet_row, stack):
+                packet_row, stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
@@ -374,12 +347,16 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     calls is its random stream rng (kernel/rng.py, advanced in place), the next photon index
     (-1 at the start), its tally row, and beam_in, the entered solar beam (weight per sun
     packet and direction below the surface) that packet -1 computes once per batch in implicit
-    mode; the split stack is empty between photons. The sky's share is stratified: round(f n)
+    mode; the split stack is empty between photons. The packet is packet_row[0] with the spectral
+    state states[0]; the stack's rows k are stack[k] and states[k + 1]; work is one event's
+    scratch (records.work_size). The sky's share is stratified: round(f n)
     packets come from the sky and carry f n / n_sky each, the rest from the sun. A photon's
     split copies (stack) are traced before the next photon. The records come as one-row
     arrays; the GIL is released, so batches run in parallel threads."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
     grid, est, ctrl, p = grid_row[0], est_row[0], ctrl_row[0], packet_row[0]
+    ps = states[0]
+    stack_ps = states[1:]
     f = sky.diffuse_fraction
     if f <= 0.0:
         n_sky = 0
@@ -413,20 +390,20 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
-        launch(p, w, ux, uy, uz, not from_sky)
+        packet.launch(p, w, ux, uy, uz, not from_sky)
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
-            spectral.start(grid, gf, tally, p, from_sky, rng)
-        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, p, rng):
+            spectral.start(grid, gf, ps, p, from_sky, rng)
+        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
             beam_in[0], beam_in[1], beam_in[2], beam_in[3] = w_sun_in, sx, sy, sz
             continue
         if grid.n_wl > 1:
-            spectral.carry(grid, tally, p)
+            spectral.carry(grid, ps, p)
         if ctrl.splitting and p.w > ctrl.split_weight:
-            n_stacked = split(ctrl, stack, n_stacked, p)
+            n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
         while True:
             # the walk of packet p as a sequence of events, until it leaves, is absorbed or
             # loses roulette; then the next of its split copies, if any
@@ -434,28 +411,28 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
             alive = True
             walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
-                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, p, tau,
-                                                  rng)
+                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, ps, p,
+                                                  tau, rng)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
                     alive, tau = collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei,
-                                         tally, p, where, walk_events, rng)
+                                         tally, ps, work, p, where, walk_events, rng)
                 elif outcome == FLIGHT_PLANE:
-                    plane, level = cross_plane(medium, mi, grid, gf, gi, tally, p, where)
+                    plane, level = cross_plane(medium, mi, grid, gf, gi, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
-                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, p, rng)
+                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf,
-                                                  est, ef, ei, tally, p, rng)
+                                                  est, ef, ei, tally, ps, work, p, rng)
                     if alive and plane != PLANE_INSIDE:
                         alive, n_stacked = after_reflection(medium, mf, mi, ctrl, grid, gf,
-                                                            gi, tally, stack, n_stacked, p,
-                                                            level, rng)
+                                                            gi, tally, ps, stack, stack_ps,
+                                                            n_stacked, p, level, rng)
                 else:
                     alive = False
             events += walk_events
             if n_stacked == 0:
                 break
             n_stacked -= 1
-            copy_packet(p, stack[n_stacked])
+            packet.copy(grid, p, ps, stack[n_stacked], stack_ps[n_stacked])
     return n_photons, events

@@ -54,6 +54,7 @@ def parts() -> dict[str, list[tuple]]:
     there is one), `water` and `entry` (the entry points, trace_batch first) here."""
     f8, i8 = numba.typeof(np.zeros(1)), numba.typeof(np.zeros(1, dtype=np.int64))
     u8 = numba.typeof(np.zeros(1, dtype=np.uint64))
+    f8_rows = numba.typeof(np.zeros((1, 1)))
     medium, surface, bottom, sky, grid, est, ctrl, packet = (
         _record(d) for d in (records.MEDIUM, records.SURFACE, records.BOTTOM, records.SKY,
                              records.GRID, records.ESTIMATES, records.ESTIMATOR, records.PACKET))
@@ -63,14 +64,15 @@ def parts() -> dict[str, list[tuple]]:
     int64, float64 = numba.int64, numba.float64
     return {
         "bottom": [(transport.reflect_at_bottom, (medium, f8, surface, bottom, f8, ctrl, grid,
-                                                  f8, est, f8, i8, f8, packet, u8))],
+                                                  f8, est, f8, i8, f8, f8, f8, packet, u8))],
         "water": [(transport.collide, (medium, f8, i8, surface, ctrl, grid, f8, est, f8, i8, f8,
-                                       packet, int64, int64, u8)),
-                  (transport.enter_from_air, (surface, ctrl, grid, f8, i8, f8, packet, u8)),
-                  (transport.leave_or_reflect, (surface, ctrl, grid, f8, i8, f8, packet, u8))],
+                                       f8, f8, packet, int64, int64, u8)),
+                  (transport.enter_from_air, (surface, ctrl, grid, f8, i8, f8, f8, packet, u8)),
+                  (transport.leave_or_reflect, (surface, ctrl, grid, f8, i8, f8, f8, packet,
+                                                u8))],
         "entry": [(trace_batch, (row_medium, f8, i8, row_surface, row_bottom, f8, row_sky, f8,
                                  row_grid, f8, i8, row_est, f8, i8, row_ctrl, int64, int64, int64,
-                                 u8, f8, f8, row_packet, row_packet)),
+                                 u8, f8, f8, row_packet, row_packet, f8_rows, f8)),
                   (layer_density, (medium, f8, i8, int64, int64, f8)),
                   (transmittance, (surface, float64))],
     }

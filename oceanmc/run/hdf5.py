@@ -32,13 +32,17 @@ COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is
                "wavelength": ("nm", "wavelength in vacuum; spectral scenes only")}
 
 
-# a partial run's unfinished batches (run/simulation.py), what --resume continues them from
+# a partial run's unfinished batches (run/simulation.py), what --resume continues them from;
+# their tallies are the named score arrays of group `tally` (scene/grid.py tally_arrays), read
+# back as keys tally/<name>
 RESUME_GROUP = "resume"
-RESUME_FIELDS = ("batch", "rng", "beam", "next_photon", "events", "tally")
+RESUME_FIELDS = ("batch", "rng", "beam", "next_photon", "events")
 RESUME_DESCRIPTION = ("state of the batches begun but not finished when the run stopped, "
                       "not part of the estimates: batch index, random stream (xoshiro256**), "
-                      "entered sun beam, next photon, scattering events, raw tally row and "
-                      "its layout (scene/grid.py TALLY_LAYOUT)")
+                      "entered sun beam, next photon, scattering events, and in group tally "
+                      "the tallies so far (batch first, wavelength last): flux (level, 4), "
+                      "radiance (level, theta, phi), local (level, direction), cap (level), "
+                      "budget")
 
 AUXILIARY_COORDS = {"direction_theta": "direction", "direction_phi": "direction"}
 
@@ -234,7 +238,7 @@ def _write(f: h5py.File, result: Result) -> None:
     if result.resume_state is not None:
         group = f.create_group(RESUME_GROUP)
         group.attrs["description"] = RESUME_DESCRIPTION
-        for name, values in result.resume_state.items():
+        for name, values in result.resume_state.items():   # a key tally/<name> lands in group tally
             group.create_dataset(name, data=values)
     if result.iops:
         _write_iops(f.create_group("iops"), result.iops)
@@ -337,14 +341,21 @@ def _read(f: h5py.File) -> Result:
             quantities[name] = Quantity(name, dims, values, str(_plain(obj.attrs["units"])),
                                         str(_plain(f[name].attrs["description"])))
     f["batches"].visititems(visit)
-    resume_state = None
-    if RESUME_GROUP in f:
-        resume_state = {name: _dataset(f[RESUME_GROUP], name, "fciu") for name in RESUME_FIELDS}
-        # files written before the layout was recorded hold layout 1 (scene/grid.py)
-        resume_state["tally_layout"] = (_dataset(f[RESUME_GROUP], "tally_layout", "iu")
-                                        if "tally_layout" in f[RESUME_GROUP] else np.array(1))
+    resume_state = None if RESUME_GROUP not in f else _read_resume(f[RESUME_GROUP])
     iops = {name: _dataset(f["iops"], name) for name in f["iops"]} if "iops" in f else {}
     return Result(coords, quantities, attrs, resume_state, iops)
+
+
+def _read_resume(group: h5py.Group) -> dict[str, np.ndarray]:
+    state = {name: _dataset(group, name, "fciu") for name in RESUME_FIELDS}
+    if isinstance(group.get("tally", getlink=True), h5py.HardLink) \
+            and isinstance(group["tally"], h5py.Group):
+        state.update({f"tally/{name}": _dataset(group["tally"], name) for name in group["tally"]})
+    else:
+        # an earlier oceanmc's raw tally rows, whose layout cannot be known: kept as stored,
+        # so that check_resumable refuses to continue them (the whole batches stay readable)
+        state["tally"] = _dataset(group, "tally")
+    return state
 
 
 # the attributes the summary, merge and --resume read, and what each must be where present

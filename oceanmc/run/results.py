@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 
 from ..kernel import models
-from ..scene.grid import TALLY_LAYOUT
 
 
 @dataclass
@@ -135,18 +134,17 @@ def check_same_data_files(stored: dict, current: dict, what: str) -> None:
 def check_resumable(part: Result) -> None:
     """Raises MergeError when part holds several runs (a merge): their unfinished batches are
     not kept and their batch ranges are not one run's, so it cannot be continued; or when its
-    unfinished batches are spectral tally rows of another layout than this oceanmc's."""
+    unfinished batches are the raw tally rows an earlier oceanmc stored (run/hdf5.py), whose
+    layout cannot be known."""
     if "merged_from" in part.attrs or "seeds" in part.attrs:
         raise MergeError(f"it merges {part.attrs.get('merged_from', 'several')} runs (seeds "
                          f"{part.attrs.get('seeds')}) and cannot be continued: resume each "
                          "partial run in its own file, then merge them")
-    state = part.resume_state   # (run/hdf5.py reads an unmarked file's layout as 1)
-    if state is not None and "wavelength" in part.coords \
-            and int(state["tally_layout"]) != TALLY_LAYOUT:
-        raise MergeError(f"its unfinished batches were stored by an earlier oceanmc, in spectral "
-                         f"tally layout {int(state['tally_layout'])} (this oceanmc's is "
-                         f"{TALLY_LAYOUT}), and cannot be continued: its whole batches stay "
-                         "readable; run the scene again for the rest")
+    if part.resume_state is not None and "tally" in part.resume_state:
+        raise MergeError("its unfinished batches were stored by an earlier oceanmc as raw tally "
+                         "rows, which this one cannot read, and cannot be continued: its "
+                         f"{part.attrs['batches']} whole batches stay readable (oceanmc show, "
+                         "oceanmc merge); run the scene again for the rest")
 
 
 def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
@@ -383,10 +381,13 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
                 "sea-surface reflectance factor L_reflected_local / L_sky, L_sky the sky "
                 "radiance (sun excluded) in the direction a flat surface reflects into the view")
     budget = raw["budget"] / n_per_batch
-    for column, name, description in budget_terms(n_layers):
+    terms = budget_terms(n_layers)
+    for column, name, description in terms:
         add(f"budget/{name}", (), budget[:, column], "1", description)
-    add("budget/total", (), budget.sum(axis=1), "1",
-        "sum of all budget terms: 1 up to Russian-roulette noise")
+    # the kernel's columns for inelastic transfers (kernel/channels/) stay 0 without an
+    # inelastic process, and are left out
+    add("budget/total", (), budget[:, sorted(column for column, _, _ in terms)].sum(axis=1),
+        "1", "sum of all budget terms: 1 up to Russian-roulette noise")
     coords = {
         "depth": np.asarray(depths, dtype=np.float64),
         "theta": grid.theta, "phi": grid.phi,

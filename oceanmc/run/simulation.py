@@ -6,8 +6,8 @@ stopped, bit for bit), each given a work budget that keeps it near CALL_SECONDS,
 checkpoint and the progress bar wait at most about that long whatever the photon count. A stop
 reports the leading whole batches (each batch an equal, independent sample: the mean and
 standard error over batches stay exact); the batches begun after them keep their state (random
-stream, next photon, entered sun beam, partial tally row) in Result.resume_state, from which a
-resumed run continues them exactly."""
+stream, next photon, entered sun beam, the tallies so far as named arrays) in
+Result.resume_state, from which a resumed run continues them exactly."""
 from __future__ import annotations
 
 import math
@@ -27,11 +27,11 @@ from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.models import BUDGET_LAYERS
-from ..kernel.records import PACKET, SPLIT_STACK_ROWS
+from ..kernel.records import PACKET, SPLIT_STACK_ROWS, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
-from ..scene.grid import TALLY_LAYOUT, tally_views
+from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
 from .compiling import ready
-from .results import Result, from_tallies, stack_wavelengths, sun_of
+from .results import MergeError, Result, from_tallies, stack_wavelengths, sun_of
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
@@ -144,12 +144,17 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     tallies = np.zeros((n_batches, row_floats(sc.tally_size)))
     events = np.zeros(n_batches, dtype=np.int64)
     if resume_state is not None:
-        _restore(resume_state, first_batch, n_batches, sc.tally_size, rngs, beams, next_photon,
+        _restore(resume_state, first_batch, n_batches, sc.grid, rngs, beams, next_photon,
                  events, tallies)
     packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
     # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
-    stacks = np.zeros((n_batches, SPLIT_STACK_ROWS if sc.splitting else 1), dtype=PACKET)
+    stack_rows = SPLIT_STACK_ROWS if sc.splitting else 1
+    stacks = np.zeros((n_batches, stack_rows), dtype=PACKET)
+    # the spectral state of the packet (row 0) and of its split copies (kernel/packet.py), and
+    # one event's scratch, each batch's on cache lines of its own
     n_wl = len(config.wavelengths)
+    states = np.zeros((n_batches, stack_rows + 1, row_floats(packet_state_size(n_wl))))
+    work = np.zeros((n_batches, row_floats(work_size(n_wl))))
     raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
     ed0, diffuse, _ = illumination_spectrum(config)
     args = sc.kernel_args()
@@ -168,7 +173,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                 t = time.perf_counter()
                 next_photon[b], n_events = trace(*args, n_per_batch, next_photon[b], budget,
                                                  rngs[b, :STATE_WORDS], beams[b], tallies[b],
-                                                 packets[b, :1], stacks[b])
+                                                 packets[b, :1], stacks[b], states[b],
+                                                 work[b])
                 events[b] += n_events
             budget = next_budget(budget, time.perf_counter() - t)
 
@@ -180,20 +186,24 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         begun = [b for b in range(done, n_batches) if next_photon[b] >= 0]
         state = None
         if begun:
+            # the tallies as named arrays (tally/flux, ...), not raw rows: the row's layout is
+            # the kernel's to change, a file's state stays readable
+            scores = tally_arrays(sc.grid, tallies)
             state = {"batch": np.array(begun, dtype=np.int64) + first_batch,
                      "rng": np.empty((len(begun), STATE_WORDS), dtype=np.uint64),
                      "beam": np.empty((len(begun), 4)),
                      "next_photon": np.empty(len(begun), dtype=np.int64),
-                     "events": np.empty(len(begun), dtype=np.int64),
-                     "tally": np.empty((len(begun), sc.tally_size)),
-                     "tally_layout": np.array(TALLY_LAYOUT)}
+                     "events": np.empty(len(begun), dtype=np.int64)}
+            state.update({f"tally/{name}": np.empty((len(begun),) + values.shape[1:])
+                          for name, values in scores.items()})
             for k, b in enumerate(begun):
                 with locks[b]:
                     state["rng"][k] = rngs[b, :STATE_WORDS]
                     state["beam"][k] = beams[b]
                     state["next_photon"][k] = next_photon[b]
                     state["events"][k] = events[b]
-                    state["tally"][k] = tallies[b, :sc.tally_size]
+                    for name, values in scores.items():
+                        state[f"tally/{name}"][k] = values[b]
         photons = done * n_per_batch
         attrs = {
             "name": config.name,
@@ -278,19 +288,26 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     return result_of(time.perf_counter() - t1)
 
 
-def _restore(state: dict[str, np.ndarray], first_batch: int, n_batches: int, tally_size: int,
-             rngs, beams, next_photon, events, tallies) -> None:
-    """Puts a partial run's unfinished batches (Result.resume_state) back where they stopped."""
-    if state["tally"].shape[1:] != (tally_size,):
-        raise ValueError(f"the stored unfinished batches have {state['tally'].shape[1:]} "
-                         f"tally values each, this scene {tally_size}")
+def _restore(state: dict[str, np.ndarray], first_batch: int, n_batches: int,
+             grid_record: np.ndarray, rngs, beams, next_photon, events, tallies) -> None:
+    """Puts a partial run's unfinished batches (Result.resume_state) back where they stopped,
+    their tally rows rebuilt from the named score arrays. Raises MergeError (one line: the CLI's
+    --resume says it and exits 2) when those arrays or batches are not this scene's."""
+    rows = np.zeros((len(state["batch"]), tallies.shape[1]))
+    try:
+        write_tally_arrays(grid_record, {key.removeprefix("tally/"): values
+                                         for key, values in state.items()
+                                         if key.startswith("tally/")}, rows)
+    except ValueError as exc:
+        raise MergeError(f"the stored unfinished batches' tallies do not fit this scene: "
+                         f"{exc}") from None
     for k, batch in enumerate(state["batch"]):
         b = int(batch) - first_batch
         if not 0 <= b < n_batches:
-            raise ValueError(f"stored unfinished batch {batch} is outside {first_batch} .. "
+            raise MergeError(f"stored unfinished batch {batch} is outside {first_batch} .. "
                              f"{first_batch + n_batches - 1}")
         rngs[b, :STATE_WORDS] = state["rng"][k]
         beams[b] = state["beam"][k]
         next_photon[b] = state["next_photon"][k]
         events[b] = state["events"][k]
-        tallies[b, :tally_size] = state["tally"][k]
+        tallies[b] = rows[k]

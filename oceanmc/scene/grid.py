@@ -1,5 +1,5 @@
 """The tally-grid packer: the angular grid of the radiance tallies, the GRID record and its
-pools (kernel/records.py), and the layout of one batch's flat tally row."""
+pools (kernel/records.py), and the named score arrays of one batch's flat tally row."""
 from __future__ import annotations
 
 import math
@@ -13,11 +13,6 @@ from ..kernel import models
 from ..kernel.records import GRID, Pool, record
 
 THETA_LOOKUP_CELLS = 4096
-# the layout of a batch's raw tally row, in which a partial run keeps its unfinished batches
-# (run/hdf5.py): 2, every spectral score with its wavelengths side by side; 1 (files before
-# 2026-11-25, none marked), one block of scores per wavelength. A one-wavelength row is the same
-# in both.
-TALLY_LAYOUT = 2
 
 
 @dataclass(frozen=True)
@@ -98,10 +93,10 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
     """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
-    (a depth profile's sublayers each absorb into a budget column of their own). A spectral
-    scene's row holds the packet's spectral state first (kernel/spectral.py), and all its
-    scores with the wavelength fastest; bottom_shares: each wavelength's bottom reflectance
-    relative to the packed BRDF's (default 1)."""
+    (a depth profile's sublayers each absorb into a budget column of their own). The row holds
+    scores only (the packet's state is the packet's: kernel/packet.py), every score with its
+    wavelengths side by side; bottom_shares: each wavelength's bottom reflectance relative to
+    the packed BRDF's (default 1)."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
@@ -110,10 +105,8 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     theta_cols, phi_cols = (len(grid.theta), len(grid.phi)) if radiance_on else (1, 1)
     n_budget = models.BUDGET_LAYERS + n_layers
     n_wl = len(config.wavelengths)
-    # the packet's spectral state (K, G, F per wavelength, D, then beta per wavelength), the
-    # local estimates' scratch (weight, tau, phase per wavelength), then their scores
-    scratch = 4 * n_wl + 1 if n_wl > 1 else 0
-    local = scratch + 3 * n_wl
+    # the local estimates' scores (wavelength fastest), then the others
+    local = 0
     cap = local + (n_depths + 1) * n_dirs * n_wl
     size = shared_size = cap + (n_depths + 1) * n_wl
     layout = {"local": local, "cap": cap}
@@ -129,7 +122,7 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
-        GRID, n_wl=n_wl, scores=shared_size, spectral=0, scratch=scratch,
+        GRID, n_wl=n_wl, scores=shared_size,
         source_q=f.add(source_q),
         bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
@@ -144,32 +137,57 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     return rec, f.array(), i.array(), grid
 
 
-def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
-                wavelength: int = 0) -> dict[str, np.ndarray]:
-    """The per-batch tally rows (batch, size) as named arrays with a batch axis first: flux
-    (level, 4), radiance (level, theta, phi), local (level, direction), cap (level), budget;
-    those of wavelength index `wavelength` in a spectral scene."""
+def tally_arrays(grid_record: np.ndarray, tallies: np.ndarray) -> dict[str, np.ndarray]:
+    """The scores of the per-batch tally rows (batch, size) as named views into them, batch
+    axis first and wavelength axis last: flux (level, 4, wl), radiance (level, theta, phi, wl),
+    local (level, direction, wl), cap (level, wl), budget (n_budget, wl). Only the GRID
+    record's score offsets are read: what else the row holds, and where, is the kernel's
+    business. Writing into the views writes the rows (write_tally_arrays)."""
     g = grid_record[0]
     nb = tallies.shape[0]
     n_levels = int(g["n_depths"]) + 2
     n_wl = int(g["n_wl"])
     scores = int(g["scores"])
 
-    def part(name, length, shape):
-        """A score array of the per-wavelength scores (kernel/tally.py spectral_at)."""
-        at = scores + (int(g[name]) - scores) * n_wl + wavelength
-        return tallies[:, at:at + length * n_wl:n_wl].reshape((nb,) + shape)
-
-    def side_by_side(name, shape):
-        """A score array of the local estimates (wavelength fastest too)."""
-        at = int(g[name])
+    def part(at, shape):
+        """The score array at row offset `at`, its wavelengths side by side."""
         length = int(np.prod(shape)) * n_wl
-        return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))[..., wavelength]
+        # a slice of each row split into axes: a view (numpy reshapes a contiguous axis
+        # without copying), so that reading it later sees what the kernel has added since
+        return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))
 
-    n_dirs = int(g["n_dirs"])
-    rad = (n_levels, int(g["theta_cols"]), int(g["phi_cols"]))
-    return {"flux": part("flux", 4 * n_levels, (n_levels, 4)),
-            "radiance": part("radiance", int(np.prod(rad)), rad),
-            "local": side_by_side("local", (n_levels - 1, n_dirs)),
-            "cap": side_by_side("cap", (n_levels - 1,)),
-            "budget": part("budget", int(g["n_budget"]), (int(g["n_budget"]),))}
+    def spectral(name, shape):
+        """A score of the per-wavelength layout: GRID gives one wavelength's offset
+        (kernel/tally.py spectral_at)."""
+        return part(scores + (int(g[name]) - scores) * n_wl, shape)
+
+    return {"flux": spectral("flux", (n_levels, 4)),
+            "radiance": spectral("radiance", (n_levels, int(g["theta_cols"]),
+                                              int(g["phi_cols"]))),
+            "local": part(int(g["local"]), (n_levels - 1, int(g["n_dirs"]))),
+            "cap": part(int(g["cap"]), (n_levels - 1,)),
+            "budget": spectral("budget", (int(g["n_budget"]),))}
+
+
+def write_tally_arrays(grid_record: np.ndarray, arrays: dict[str, np.ndarray],
+                       tallies: np.ndarray) -> None:
+    """The inverse of tally_arrays: writes the named score arrays (each with the batch axis
+    first and the wavelength axis last) into the rows `tallies` (batch, size). Raises
+    ValueError when their names or shapes are not those of this grid."""
+    views = tally_arrays(grid_record, tallies)
+    if set(arrays) != set(views):
+        raise ValueError(f"the tally holds {sorted(arrays)}, this scene's {sorted(views)}")
+    for name, view in views.items():
+        if np.shape(arrays[name]) != view.shape:
+            raise ValueError(f"tally {name} is {np.shape(arrays[name])}, this scene's "
+                             f"{view.shape} (batch, ..., wavelength)")
+    for name, view in views.items():
+        view[...] = arrays[name]
+
+
+def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
+                wavelength: int = 0) -> dict[str, np.ndarray]:
+    """The named score arrays of tally_arrays at wavelength index `wavelength` (views into the
+    rows)."""
+    return {name: values[..., wavelength]
+            for name, values in tally_arrays(grid_record, tallies).items()}

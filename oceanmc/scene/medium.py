@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
-from .. import optics
+from .. import optics, registry
 from ..kernel import models
 from ..kernel.records import MEDIUM, Pool, record
 from . import phase_tables
@@ -102,13 +102,6 @@ def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray
 
 def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> None:
     """What the one-history spectral walk (kernel/spectral.py) does not carry: one line each."""
-    est = config.estimator
-    for key, value, off in (("estimator.mode", est.mode, "implicit"),
-                            ("estimator.split_weight", est.split_weight, None),
-                            ("estimator.upward_fraction", est.upward_fraction, None)):
-        if value != off:
-            raise cfg.ConfigError(f"{key} = {value!r} with {len(config.wavelengths)} wavelengths: "
-                                  f"the spectral walk needs {key} = {off!r}")
     for layer in layers:
         scatters = layer.b > 0.0
         if scatters.any() and not scatters.all():
@@ -161,7 +154,9 @@ def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
     """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
     values per layer; optical depths wavelength-major (the local estimates read them); the
-    Column's albedo is the first wavelength's."""
+    Column's albedo is the largest of each layer's wavelengths' (it caps the upward bias, which
+    a spectral walk applies at every wavelength: kernel/upward.py). One collision channel,
+    elastic scattering, takes all of b (kernel/channels/)."""
     layers = optics.column_iops(config)
     n_wl = len(config.wavelengths)
     if n_wl > 1:
@@ -226,7 +221,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
     layer_c = np.array([layer.c for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
     albedo_all = np.divide(layer_b, layer_c, out=np.zeros_like(layer_c), where=layer_b > 0.0)
-    albedo = albedo_all[:, 0]
+    albedo = albedo_all.max(axis=1)
     plane_tau = np.array([optical_depths(plane_z, segment_layer, layer_c[:, j])
                           for j in range(n_wl)])                             # (n_wl, n_planes)
     level_tau = plane_tau[:, np.searchsorted(plane_z, depths)]              # (n_wl, n_depths)
@@ -238,7 +233,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
         MEDIUM, n_planes=len(plane_z), n_layers=len(layers), n_wl=n_wl,
-        n_comps=len(comp_model), up_cos=up_cos,
+        n_comps=len(comp_model), n_channels=1, up_cos=up_cos,
         plane_z=f.add(plane_z), plane_tau=f.add(plane_tau), layer_c=f.add(layer_c),
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
@@ -258,6 +253,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         comp_tab_len=i.add(tab_len), comp_psi_start=i.add(psi_start),
         tab_guide=i.add(np.concatenate(guide_parts) if guide_parts else np.zeros(0, np.int64)),
         mix_ptr=i.add(mix_ptr), mix_comp=i.add(mix_comp), mix_at=i.add(mix_at),
-        mix_coef=f.add(mix_coef))
+        mix_coef=f.add(mix_coef),
+        channel_b=f.add(layer_b), channel_model=i.add([registry.CHANNEL["elastic"][0]]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
     return rec, f.array(), i.array(), column

@@ -1,0 +1,70 @@
+"""The photon packet: a PACKET record (kernel/records.py: position, weight, direction, beam flag,
+hero and reference wavelengths) and its spectral state, a float row of its own `ps`
+(records.packet_state_size). The split stack holds rows of both, so a copy of a packet is
+the whole packet at every wavelength.
+
+The spectral state of a walk of n wavelengths (kernel/spectral.py says what each part means):
+K (n), G (n), F at the last settle (n), then D, the free path since the last settle. A
+one-wavelength walk keeps its whole state in the record (p.w) and reads no row.
+
+Only this module knows the row's layout: every other function takes the views of weights()."""
+from .compile import internal, kernel
+
+
+@kernel
+def weights(grid, ps):
+    """Views of the packet's spectral state: K, G (each wavelength's share of p.w: what a scorer
+    multiplies a packet's weight by) and F at the last settle (n_wl each). The loops over
+    wavelengths index these views from 0, which lets LLVM vectorise them (an offset index of
+    unknown sign costs a wraparound test per element; measured 2.5x slower)."""
+    n = grid.n_wl
+    return ps[:n], ps[n:2 * n], ps[2 * n:3 * n]
+
+
+@kernel
+def free_path_at(grid):
+    """Where D, the free path since the last settle, lies in the row."""
+    return 3 * grid.n_wl
+
+
+@internal
+def launch(p, w, ux, uy, uz, beam):
+    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz);
+    beam: it belongs to the collimated solar beam (the spectral state is set by
+    spectral.start)."""
+    p.z = 0.0
+    p.seg = 0
+    p.w = w
+    p.ux = ux
+    p.uy = uy
+    p.uz = uz
+    p.beam = 1 if beam else 0
+
+
+@internal
+def copy(grid, dst, dst_ps, src, src_ps):
+    """The whole packet src (record and spectral state) into dst."""
+    dst.z = src.z
+    dst.w = src.w
+    dst.ux = src.ux
+    dst.uy = src.uy
+    dst.uz = src.uz
+    dst.seg = src.seg
+    dst.beam = src.beam
+    dst.wavelength = src.wavelength
+    dst.reference = src.reference
+    if grid.n_wl > 1:
+        for j in range(free_path_at(grid) + 1):
+            dst_ps[j] = src_ps[j]
+
+
+@kernel
+def divide(grid, p, ps, copies):
+    """The packet's weight at every wavelength divided by `copies` (splitting): p.w, and what
+    it carried at its last settle (the settle's budget books differences from it); K and G are
+    ratios and stay."""
+    p.w /= copies
+    if grid.n_wl > 1:
+        _, _, last = weights(grid, ps)
+        for j in range(grid.n_wl):
+            last[j] /= copies
