@@ -142,7 +142,7 @@ def test_small_upward_cone_density_does_not_cancel(small_scene):
     cone = math.radians(0.01)
     # 2 pi (1 - cos A) by its series 2 pi (A^2/2 - A^4/24), exact to 1e-20 relative here
     solid_angle = 2.0 * math.pi * (cone ** 2 / 2.0 - cone ** 4 / 24.0)
-    density = built.mf[int(built.medium["up_density"][0])]
+    density = built.floats[int(built.medium["up_density"][0])]
     assert abs(density / (0.1 / solid_angle) - 1.0) < 1e-12
 
 

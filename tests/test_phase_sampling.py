@@ -48,7 +48,7 @@ def scene_arrays(phase: dict, b: float = 1.0):
         layer["b"] = b   # a mixture's b is the sum of its components'
     config = oceanmc.load_config({"water": {"layers": [layer]}, "bottom": {"model": "black"}})
     built = scene.build(config)
-    return built.medium, built.mf, built.mi
+    return built.medium, built.floats, built.ints
 
 
 def sample(phase: dict, n: int = N_SAMPLES, seed: int = 1) -> np.ndarray:

@@ -78,7 +78,7 @@ def test_phase_dispatch_reaches_each_kernel_module():
             "bottom": {"model": "black"}}))
         from oceanmc.kernel.phase import dispatch
         for mu in (-0.9, 0.0, 0.3, 0.99):
-            assert dispatch.evaluate(sc.medium[0], sc.mf, sc.mi, 0, mu) == pytest.approx(
+            assert dispatch.evaluate(sc.medium[0], sc.floats, sc.ints, 0, mu) == pytest.approx(
                 module.evaluate(params, mu), rel=1e-14)
 
 
@@ -148,8 +148,8 @@ def test_channel_registry_and_dispatch():
         "water": {"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 1.0,
                               "phase": {"model": "isotropic"}}]},
         "bottom": {"model": "black"}}))
-    assert sc.mi[sc.medium[0]["channel_model"]] == registry.CHANNEL["elastic"][0]
-    arrays = (sc.medium, sc.mf, sc.mi, sc.estimator, sc.grid, np.zeros(1, dtype=records.PACKET),
+    assert sc.ints[sc.medium[0]["channel_model"]] == registry.CHANNEL["elastic"][0]
+    arrays = (sc.medium, sc.floats, sc.ints, sc.estimator, sc.grid, np.zeros(1, dtype=records.PACKET),
               np.zeros(1), np.zeros(4), np.zeros(sc.tally_size))
     rng = batch_state(3, 0)
     turned = [run(arrays, registry.CHANNEL["elastic"][0], rng) for _ in range(20)]

@@ -59,7 +59,7 @@ def base(sky, **over):
 
 def draw(sky, n, seed=1, **over):
     sc = scene.build(load_config(base(sky, **over)))
-    return sky_many(sc.sky, sc.sf, n, batch_state(seed, 0))
+    return sky_many(sc.sky, sc.floats, n, batch_state(seed, 0))
 
 
 def view_angles(u):
@@ -144,11 +144,11 @@ def test_cosine_map_sampling(tmp_path):
                     * np.radians(np.diff(phi_e))[None, :] / 2.0)
     expected_weight = L * math.pi / energy
     rec = sc.sky[0]
-    cell_l = sc.sf[rec["cell_l"]:rec["cell_l"] + L.size].reshape(L.shape)
+    cell_l = sc.floats[rec["cell_l"]:rec["cell_l"] + L.size].reshape(L.shape)
     np.testing.assert_allclose(cell_l, expected_weight, rtol=1e-12)
     assert np.sum(solid_cos * expected_weight) == pytest.approx(1.0, rel=1e-12)
     n = 300_000
-    u = sky_many(sc.sky, sc.sf, n, batch_state(2, 0))
+    u = sky_many(sc.sky, sc.floats, n, batch_state(2, 0))
     assert np.all(u[:, 2] > 0.0)
     np.testing.assert_allclose(np.linalg.norm(u[:, :3], axis=1), 1.0, atol=1e-12)
     t, p = view_angles(u)
@@ -575,7 +575,7 @@ def test_exr_map_same_tables_as_npy(tmp_path, sampling):
                                       "sampling": sampling})))
     b = scene.build(load_config(base({"map": str(tmp_path / "rgb.npy"),
                                       "sampling": sampling})))
-    assert_same_fields((a.sky, a.sf), (b.sky, b.sf))
+    assert_same_fields((a.sky, a.floats), (b.sky, b.floats))
 
 
 def test_bad_exr_files(tmp_path):

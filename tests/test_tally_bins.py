@@ -23,11 +23,11 @@ def test_theta_lookup_matches_binary_search(edges):
     sc = _scene(theta_edges_deg=edges)
     grid = sc.grid[0]
     rng = np.random.default_rng(1)
-    mu = sc.gf[grid["theta_mu_edges"]:grid["theta_mu_edges"] + grid["n_theta"] + 1]
+    mu = sc.floats[grid["theta_mu_edges"]:grid["theta_mu_edges"] + grid["n_theta"] + 1]
     uz = np.clip(np.concatenate([rng.uniform(-1, 1, 50_000), mu, np.nextafter(mu, 2),
                                  np.nextafter(mu, -2)]), -1.0, 1.0)
     for u in uz:
-        assert theta_band_fast(grid, sc.gf, sc.gi, u) == theta_band(u, mu), u
+        assert theta_band_fast(grid, sc.floats, sc.ints, u) == theta_band(u, mu), u
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 24, 360])
@@ -39,4 +39,4 @@ def test_phi_bins_match_atan2_off_the_edges(n):
                              edges - 1e-9, [0.0, math.pi / 2, math.pi, -math.pi / 2]])
     for a, r in zip(angles, rng.uniform(1e-3, 1.0, angles.size)):
         ux, uy = r * math.cos(a), r * math.sin(a)
-        assert phi_band_fast(sc.grid[0], sc.gf, ux, uy) == phi_band(ux, uy, n), a
+        assert phi_band_fast(sc.grid[0], sc.floats, ux, uy) == phi_band(ux, uy, n), a

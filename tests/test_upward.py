@@ -53,7 +53,7 @@ def _scatter(sc, n, rng, ux, uy, uz):
 
 
 def _draw(sc, n, rng, ux, uy, uz):
-    return _scatter((sc.medium, sc.mf, sc.mi, sc.estimator, sc.grid,
+    return _scatter((sc.medium, sc.floats, sc.ints, sc.estimator, sc.grid,
                      np.zeros(1, dtype=records.PACKET), np.zeros(1), np.zeros(4),
                      np.zeros(sc.tally_size)), n, rng, ux, uy, uz)
 
@@ -108,7 +108,7 @@ def test_fraction_is_capped_by_the_albedo():
     """min(upward_fraction, 1 - w0) per layer, so a scattering event never makes a packet
     heavier; the feature bit is set only with a positive fraction."""
     def fraction(sc):
-        return sc.mf[sc.medium[0]["up_fraction"]]
+        return sc.floats[sc.medium[0]["up_fraction"]]
     assert fraction(arrays(a=0.1, b=0.4)) == pytest.approx(0.1)
     assert fraction(arrays(a=0.01, b=0.99)) == pytest.approx(0.01)
     assert arrays().estimator[0]["upward"]

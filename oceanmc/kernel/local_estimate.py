@@ -47,71 +47,71 @@ def scratch(grid, work):
 
 
 @internal
-def optical_depth(medium, mf, seg, layer, z, j):
+def optical_depth(medium, floats, seg, layer, z, j):
     """tau at wavelength index j from the surface to depth z in segment seg (of the given
     layer)."""
-    return mf[medium.plane_tau + j * medium.n_planes + seg] + mf[
-        medium.layer_c + layer * medium.n_wl + j] * (z - mf[medium.plane_z + seg])
+    return floats[medium.plane_tau + j * medium.n_planes + seg] + floats[
+        medium.layer_c + layer * medium.n_wl + j] * (z - floats[medium.plane_z + seg])
 
 
 @internal
-def direction(est, ef, k):
+def direction(est, floats, k):
     """The in-water direction (travel, up) of local-estimate row k."""
     at = est.dirs + 3 * k
-    return ef[at], ef[at + 1], ef[at + 2]
+    return floats[at], floats[at + 1], floats[at + 2]
 
 
 @kernel
-def layer_phase(medium, mf, mi, grid, layer, cos_psi, out):
+def layer_phase(medium, floats, ints, grid, layer, cos_psi, out):
     """The layer's phase function p_j(cos_psi) in 1/sr at every wavelength into out (called,
     not inlined: its two call sites, exact directions through the flat and the rough surface,
     would otherwise each carry a copy of the spectral terms' reading into the collision)."""
     if grid.n_wl == 1:
-        out[0] = phase.evaluate(medium, mf, mi, layer, cos_psi)
+        out[0] = phase.evaluate(medium, floats, ints, layer, cos_psi)
     else:
-        spectral.phase_values(medium, mf, mi, layer, cos_psi, out)
+        spectral.phase_values(medium, floats, ints, layer, cos_psi, out)
 
 
 @internal
-def add_to_levels(est, ef, ei, grid, gf, tally, z, tau_here, k, base, mu, j):
+def add_to_levels(est, floats, ints, grid, tally, z, tau_here, k, base, mu, j):
     """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
     t/n^2; 0 if it is not scored there), at wavelength index j."""
     n = grid.n_wl
     row = est.n_dirs * n     # one level's scores: direction-major, wavelength fastest
     local = grid.local + k * n + j
     taus = grid.level_tau + j * grid.n_depths
-    if ei[est.in_water + k]:
+    if ints[est.in_water + k]:
         for level in range(grid.n_depths):
-            if gf[grid.level_z + level] <= z:
+            if floats[grid.level_z + level] <= z:
                 tally[local + level * row] += base * math.exp(
-                    -(tau_here - gf[taus + level]) / mu)
-    factor = ef[est.air_factor + k]
+                    -(tau_here - floats[taus + level]) / mu)
+    factor = floats[est.air_factor + k]
     if factor > 0.0:
         tally[local + grid.n_depths * row] += base * math.exp(-tau_here / mu) * factor
 
 
 @internal
-def cap_lookup(est, ef, table, i, f, n_wl, j):
+def cap_lookup(est, floats, table, i, f, n_wl, j):
     """(M0, M1) of the water cap and of the air cap's water side at wavelength index j of
     table `table`, linear in alpha between nodes i and i + 1 and the fraction f of the way."""
     g = 1.0 - f
     at = (table * est.n_alpha + i) * n_wl + j
     up = at + n_wl
-    return (g * ef[est.cap_m0w + at] + f * ef[est.cap_m0w + up],
-            g * ef[est.cap_m1w + at] + f * ef[est.cap_m1w + up],
-            g * ef[est.cap_m0a + at] + f * ef[est.cap_m0a + up],
-            g * ef[est.cap_m1a + at] + f * ef[est.cap_m1a + up])
+    return (g * floats[est.cap_m0w + at] + f * floats[est.cap_m0w + up],
+            g * floats[est.cap_m1w + at] + f * floats[est.cap_m1w + up],
+            g * floats[est.cap_m0a + at] + f * floats[est.cap_m0a + up],
+            g * floats[est.cap_m1a + at] + f * floats[est.cap_m1a + up])
 
 
 @internal
-def into_water_through_rough(surface, est, ef, k, rng):
+def into_water_through_rough(surface, est, floats, k, rng):
     """(ix, iy, iz, t): for air row k (upward air direction o, stored as its flat-surface
     refracted in-water direction), an in-water direction of travel i whose light the rough
     surface sends into o, with t = 1, or t = 0 (nothing sent): one sample of the facet walk of
     a photon travelling -o from the air, reversed. By the walk's reciprocity (f(i->o) / n_o^2 =
     f(o->i) / n_i^2 for a dielectric BSDF; Veach 1997, PhD thesis, 5.2) the radiance L(o) at 0+
     is the expectation of t L_water(i) / n^2, which the row's air factor 1/n^2 completes."""
-    dx, dy, dz = direction(est, ef, k)
+    dx, dy, dz = direction(est, floats, k)
     n = surface.n_water
     ax = n * dx
     ay = n * dy
@@ -122,7 +122,7 @@ def into_water_through_rough(surface, est, ef, k, rng):
 
 
 @internal
-def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m0w, m1w, m0a,
+def cap_from_collision(est, floats, grid, tally, above, tau_here, w_scattered, m0w, m1w, m0a,
                        m1a, j):
     """The polar-cap average of the nadir-viewing radiance that a collision sends to the
     `above` levels above it and to 0+, at wavelength index j (see scene/estimates.py for the
@@ -136,13 +136,13 @@ def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m
     mu = est.mu_w
     if above > 0:
         decay = est.level_decay + j * grid.n_depths
-        transmitted = math.exp(-(tau_here - gf[taus + above - 1]) / mu)
+        transmitted = math.exp(-(tau_here - floats[taus + above - 1]) / mu)
         scale = w_scattered / (mu * est.omega_w)
         for level in range(above - 1, -1, -1):
-            dtau = tau_here - gf[taus + level]
+            dtau = tau_here - floats[taus + level]
             tally[cap + level * n] += scale * transmitted * (
                 m0w + m1w * (dtau / mu - 1.0) / mu)
-            transmitted *= ef[decay + level]
+            transmitted *= floats[decay + level]
     mu = est.mu_a
     e = math.exp(-tau_here / mu)
     tally[cap + grid.n_depths * n] += w_scattered * e * (
@@ -150,7 +150,7 @@ def cap_from_collision(est, ef, grid, gf, tally, above, tau_here, w_scattered, m
 
 
 @internal
-def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps, work, p, layer,
+def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, layer,
                  w_scattered, rng):
     """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene)
     sends into the exact directions (at every level above it and 0+), and the polar-cap
@@ -160,30 +160,30 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps, work
     if n == 1:
         weight[0] = w_scattered
     else:
-        spectral.collision_weights(medium, mf, grid, ps, p, layer, weight)
+        spectral.collision_weights(medium, floats, grid, ps, p, layer, weight)
     z = p.z
     for j in range(n):
-        tau[j] = optical_depth(medium, mf, p.seg, layer, z, j)
+        tau[j] = optical_depth(medium, floats, p.seg, layer, z, j)
     ux, uy, uz = p.ux, p.uy, p.uz
     if est.directions_on:
         rough = surface.delta == 0
         for k in range(est.n_dirs):
-            factor = ef[est.air_factor + k]
+            factor = floats[est.air_factor + k]
             if rough and factor > 0.0:
-                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
+                ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
                 if t > 0.0 and iz < 0.0:
-                    layer_phase(medium, mf, mi, grid, layer, ux * ix + uy * iy + uz * iz,
+                    layer_phase(medium, floats, ints, grid, layer, ux * ix + uy * iy + uz * iz,
                                 phase_j)
                     at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
                         tally[at + j] += (
                             weight[j] * phase_j[j] * t * math.exp(tau[j] / iz) / -iz * factor)
                 continue
-            dx, dy, dz = direction(est, ef, k)
+            dx, dy, dz = direction(est, floats, k)
             mu = -dz
-            layer_phase(medium, mf, mi, grid, layer, ux * dx + uy * dy + uz * dz, phase_j)
+            layer_phase(medium, floats, ints, grid, layer, ux * dx + uy * dy + uz * dz, phase_j)
             for j in range(n):
-                add_to_levels(est, ef, ei, grid, gf, tally, z, tau[j], k,
+                add_to_levels(est, floats, ints, grid, tally, z, tau[j], k,
                               weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
         # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
@@ -195,18 +195,18 @@ def at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps, work
             x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
         i = min(int(x), est.n_alpha - 2)
         f = x - i
-        table = ei[est.table_of_layer + layer]
+        table = ints[est.table_of_layer + layer]
         above = 0   # the tally levels at or above the collision (sorted by depth)
-        while above < grid.n_depths and gf[grid.level_z + above] <= z:
+        while above < grid.n_depths and floats[grid.level_z + above] <= z:
             above += 1
         for j in range(n):
-            m0w, m1w, m0a, m1a = cap_lookup(est, ef, table, i, f, n, j)
-            cap_from_collision(est, ef, grid, gf, tally, above, tau[j], weight[j], m0w, m1w,
+            m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
+            cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j], m0w, m1w,
                                m0a, m1a, j)
 
 
 @internal
-def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, ps, work, p, rng):
+def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng):
     """Packet p meets the bottom travelling (ux, uy, uz) (in the BRDF's local frame (x, -y,
     -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
     directions, and the polar-cap average from one direction W drawn uniformly in the cap (an
@@ -219,18 +219,18 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, ps,
     if n == 1:
         weight[0] = p.w
     else:
-        spectral.bottom_weights(grid, gf, ps, p, weight)
+        spectral.bottom_weights(grid, floats, ps, p, weight)
     for j in range(n):
-        tau[j] = mf[medium.plane_tau + j * medium.n_planes + bottom_plane]
-    z = mf[medium.plane_z + bottom_plane]
+        tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
+    z = floats[medium.plane_z + bottom_plane]
     ux, uy, uz = p.ux, p.uy, p.uz
     model = bottom.model
     if est.directions_on:
         rough = surface.delta == 0
         for k in range(est.n_dirs):
-            factor = ef[est.air_factor + k]
+            factor = floats[est.air_factor + k]
             if rough and factor > 0.0:
-                ix, iy, iz, t = into_water_through_rough(surface, est, ef, k, rng)
+                ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
                 if t > 0.0 and iz < 0.0:
                     f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz)
                     at = grid.local + (grid.n_depths * est.n_dirs + k) * n
@@ -238,10 +238,10 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, ps,
                         tally[at + j] += (
                             weight[j] * f * t * math.exp(tau[j] / iz) * factor)
                 continue
-            dx, dy, dz = direction(est, ef, k)
+            dx, dy, dz = direction(est, floats, k)
             f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
             for j in range(n):
-                add_to_levels(est, ef, ei, grid, gf, tally, z, tau[j], k, weight[j] * f, -dz, j)
+                add_to_levels(est, floats, ints, grid, tally, z, tau[j], k, weight[j] * f, -dz, j)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
@@ -249,9 +249,9 @@ def at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally, ps,
         for j in range(n):
             taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
-                if gf[grid.level_z + level] <= z:
+                if floats[grid.level_z + level] <= z:
                     tally[grid.cap + level * n + j] += weight[j] * f * math.exp(
-                        -(tau[j] - gf[taus + level]) / mu)
+                        -(tau[j] - floats[taus + level]) / mu)
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
         sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n_water

@@ -1,15 +1,20 @@
-"""The scene as the compiled code sees it: one narrow record per component, and flat pools.
+"""The scene as the compiled code sees it: one narrow record per component, and two flat pools.
 
 Each component (medium, surface, bottom, sky, tally grid, local estimates, estimator) is one
 numpy structured scalar of a fixed dtype below, passed to the kernel as a one-row array. Its
-scalar fields are read directly; its tables live in the component's flat pools (float64, and
-int64 where needed), and the record holds their offsets: a field named like a table (plane_z,
-layer_c, ...) is the offset of that table in the pool. So every scene, whatever its number of
-layers, tables or tally depths, has the same types, and each compiled function is compiled once
-(MC/DC's records plus one flat data array, CEMeNT-PSAAP/MCDC).
+scalar fields are read directly; its tables live in the scene's two flat pools, one float64 and
+one int64, and the record holds their offsets: a field named like a table (plane_z, layer_c,
+...) is the offset of that table in its pool (each record's `floats_at` and `ints_at` name
+them). So every scene, whatever its number of layers, tables or tally depths, has the same
+types, each compiled function is compiled once, and a function below the photon loop takes the
+records it needs and the two pools (MC/DC's records plus one flat data array,
+CEMeNT-PSAAP/MCDC). Each packer fills pools of its own with offsets from 0 (Pool); merge()
+appends them to the scene's pools and moves the records' offsets with them. Offsets stored
+inside a pool are relative to a record's offset (mix_at to mix_coef, comp_tab_start to tab_q,
+the BRDF's header to its params), so they move with it.
 
 The packet is a record too (PACKET) with its spectral state in a float row of its own
-(packet_state_size: kernel/spectral.py); the split stack holds rows of both. One event's
+(packet_state_size: kernel/packet.py); the split stack holds rows of both. One event's
 scratch (work_size) is a third row, kept by no packet.
 
 The tallies of one batch are one flat float64 row of scores and nothing else; the GRID record
@@ -21,13 +26,22 @@ import numpy as np
 
 I8 = np.int64
 F8 = np.float64
+# each record dtype's offset fields: (into the float pool, into the int pool)
+POOL_OFFSETS: dict[np.dtype, tuple[tuple[str, ...], tuple[str, ...]]] = {}
 
 
-def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
-    """A record dtype whose scalars are np.record (attribute access, also in plain Python under
-    NUMBA_DISABLE_JIT=1); to Numba the same type as the plain structured dtype."""
-    return np.dtype((np.record, np.dtype([(name, I8 if name in ints else F8) for name in fields],
-                                         align=True)))
+def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...] = (),
+            ints_at: tuple[str, ...] = ()) -> np.dtype:
+    """A record dtype of the scalar fields (int64 if named in ints, else float64) and the
+    offsets of its tables in the float pool (floats_at) and the int pool (ints_at). Its scalars
+    are np.record (attribute access, also in plain Python under NUMBA_DISABLE_JIT=1); to Numba
+    the same type as the plain structured dtype."""
+    offsets = set(floats_at) | set(ints_at)
+    dtype = np.dtype((np.record, np.dtype(
+        [(name, I8 if name in ints or name in offsets else F8)
+         for name in fields + floats_at + ints_at], align=True)))
+    POOL_OFFSETS[dtype] = (floats_at, ints_at)
+    return dtype
 
 
 # Water column: planes (surface first, then layer boundaries and tally depths, bottom last; z =
@@ -41,30 +55,24 @@ def _record(*fields: str, ints: tuple[str, ...] = ()) -> np.dtype:
 #               up_keep (n_layers); comp_cumweight (n_wl x n_comps; cumulative within each
 #               layer), comp_params (2 each); tab_psi (each distinct angle grid once, at a
 #               component's psi_start), tab_q, tab_cdf (each table at its component's
-#               tab_start); mix_coef
+#               tab_start); mix_coef; channel_b (n_layers x n_channels x n_wl: each collision
+#               channel's scattering coefficient, adding up to the layer's b; kernel/channels/)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
 #               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1),
 #               mix_comp, mix_at: the terms of each layer's volume scattering functions, all
-#               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py)
-#   collision channels (kernel/channels/): float pool channel_b (n_layers x n_channels x n_wl:
-#               each channel's scattering coefficient, adding up to the layer's b); int pool
+#               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py);
 #               channel_model (n_channels: registry.CHANNEL ids)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
-    "plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b",
-    "up_fraction", "up_density", "up_keep", "comp_cumweight", "comp_params",
-    "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-    "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
-    "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr", "mix_comp",
-    "mix_at", "channel_b", "channel_model",
-    ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "plane_z", "plane_tau",
-          "layer_c", "layer_inv_c", "layer_albedo", "layer_c_over_b", "up_fraction", "up_density",
-          "up_keep", "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-          "plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
-          "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
-          "mix_comp", "mix_at", "channel_b", "channel_model"))
+    ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),
+    floats_at=("plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
+               "layer_c_over_b", "up_fraction", "up_density", "up_keep", "comp_cumweight",
+               "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef", "channel_b"),
+    ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
+             "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
+             "mix_comp", "mix_at", "channel_model"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
@@ -73,43 +81,43 @@ MEDIUM = _record(
 SURFACE = _record("model", "n_water", "schlick", "delta", "alpha_u", "alpha_c", "wind_cos",
                   "wind_sin", ints=("model", "schlick", "delta"))
 
-# The bottom (kernel/brdf/): model id; its parameters are the bottom pool (brdf_tables layout).
-BOTTOM = _record("model", "reflects", "mirror", ints=("model", "reflects", "mirror"))
+# The bottom (kernel/brdf/): model id; params: its parameters (scene/brdf_tables.py layout,
+# whose offsets are relative to params) in the float pool.
+BOTTOM = _record("model", "reflects", "mirror", ints=("model", "reflects", "mirror"),
+                 floats_at=("params",))
 
 # Sun and sky (kernel/sources.py).
 #   float pool: s_edges (n_rows + 1; sin^2 of the view zenith), phi_edges (n_cols + 1; rad),
 #               row_cdf (n_rows), cell_cdf and cell_l (n_rows x n_cols, row-major), params (8)
 SKY = _record(
     "sun_mu", "sun_sin", "diffuse_fraction", "model", "n_rows", "n_cols",
-    "s_edges", "phi_edges", "row_cdf", "cell_cdf", "cell_l", "params",
-    ints=("model", "n_rows", "n_cols", "s_edges", "phi_edges", "row_cdf", "cell_cdf",
-          "cell_l", "params"))
+    ints=("model", "n_rows", "n_cols"),
+    floats_at=("s_edges", "phi_edges", "row_cdf", "cell_cdf", "cell_l", "params"))
 
 # Tally grid and the layout of one batch's tally row (kernel/tally.py).
 #   levels: the in-water tally depths (n_depths), then air (0+, all light), then air_leaving
 #   (0+, water-leaving light only).
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
-#               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths)
+#               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths),
+#               source_q (2 x n_wl: sun, sky), bottom_q (n_wl) (kernel/spectral.py)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
-#               spectral scenes: source_q (2 x n_wl: sun, sky), bottom_q (n_wl)
 #   tally row:  the local estimates' scores, local ((n_depths + 1) x n_dirs x n_wl) and cap
-#               ((n_depths + 1) x n_wl); then, from `scores` on, flux (n_levels x 4), radiance (n_levels x n_theta_cols x
-#               n_phi_cols), budget (n_budget), each score with its n_wl wavelengths side by
-#               side: the offsets below are those of one wavelength's layout, and the score at
-#               offset i of wavelength j lies at scores + (i - scores) n_wl + j (tally.py
-#               spectral_at: the same address when n_wl = 1)
+#               ((n_depths + 1) x n_wl); then, from `scores` on, flux (n_levels x 4),
+#               radiance (n_levels x n_theta_cols x n_phi_cols), budget (n_budget), each
+#               score with its n_wl wavelengths side by side: the offsets below are those of
+#               one wavelength's layout, and the score at offset i of wavelength j lies at
+#               scores + (i - scores) n_wl + j (tally.py spectral_at: the same address when
+#               n_wl = 1)
 GRID = _record(
-    "n_wl", "scores", "source_q", "bottom_q",
-    "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on", "n_theta", "n_phi",
-    "n_lookup", "theta_cols", "phi_cols",
-    "theta_mu_edges", "phi_edge_cos", "phi_edge_sin", "level_z", "level_tau",
-    "theta_lookup", "theta_is_cap",
+    "n_wl", "scores", "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on",
+    "n_theta", "n_phi", "n_lookup", "theta_cols", "phi_cols",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "scores", "source_q", "bottom_q",
-          "n_depths", "air_level", "surface_level", "radiance_on", "n_theta", "n_phi",
-          "n_lookup", "theta_cols", "phi_cols", "theta_mu_edges", "phi_edge_cos",
-          "phi_edge_sin", "level_z", "level_tau", "theta_lookup", "theta_is_cap", "flux",
-          "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size"))
+    ints=("n_wl", "scores", "n_depths", "air_level", "surface_level", "radiance_on", "n_theta",
+          "n_phi", "n_lookup", "theta_cols", "phi_cols", "flux", "radiance", "local", "cap",
+          "budget", "n_dirs", "n_budget", "size"),
+    floats_at=("source_q", "bottom_q", "theta_mu_edges", "phi_edge_cos", "phi_edge_sin",
+               "level_z", "level_tau"),
+    ints_at=("theta_lookup", "theta_is_cap"))
 
 # Local (next-event) estimates (kernel/local_estimate.py): exact upward directions, and the
 # nadir polar-cap average (tables from scene/estimates.py).
@@ -121,11 +129,9 @@ ESTIMATES = _record(
     "directions_on", "cap_on", "n_dirs", "n_alpha",
     "fine_end", "fine_step", "coarse_step", "fine_nodes",
     "mu_w", "omega_w", "cos_water", "mu_a", "omega_a", "cos_air", "h", "dh",
-    "dirs", "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay",
-    "in_water", "table_of_layer",
-    ints=("directions_on", "cap_on", "n_dirs", "n_alpha", "fine_nodes", "dirs",
-          "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay",
-          "in_water", "table_of_layer"))
+    ints=("directions_on", "cap_on", "n_dirs", "n_alpha", "fine_nodes"),
+    floats_at=("dirs", "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay"),
+    ints_at=("in_water", "table_of_layer"))
 
 # How weights evolve (kernel/transport.py).
 ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",
@@ -189,3 +195,23 @@ class Pool:
         if not self.parts:
             return np.zeros(1, dtype=self.dtype)
         return np.concatenate(self.parts + [np.zeros(1, dtype=self.dtype)])
+
+
+def merge(parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
+          ) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """The scene's records, float pool and int pool from each component's (record, float pool,
+    int pool), whose offsets count from 0: each component's pools are appended in turn and its
+    record's offsets (POOL_OFFSETS) moved by where they start."""
+    floats, ints = Pool(F8), Pool(I8)
+    records = []
+    for rec, part_floats, part_ints in parts:
+        rec = rec.copy()
+        float_base = floats.add(part_floats)
+        int_base = ints.add(part_ints)
+        floats_at, ints_at = POOL_OFFSETS[rec.dtype]
+        for name in floats_at:
+            rec[name] += float_base
+        for name in ints_at:
+            rec[name] += int_base
+        records.append(rec)
+    return records, floats.array(), ints.array()

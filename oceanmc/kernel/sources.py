@@ -26,19 +26,19 @@ def sky_cosine(sky_model, rng):
 
 
 @kernel
-def harrison_coombes(sf, p, ux, uy, uz):
+def harrison_coombes(floats, p, ux, uy, uz):
     """Harrison & Coombes (1988) radiance of the sky element a photon travelling (ux, uy, uz)
-    comes from (sf[p:p + 4]: sun travel direction, cos of the sun zenith); sky_maps.py has the
+    comes from (floats[p:p + 4]: sun travel direction, cos of the sun zenith); sky_maps.py has the
     formula."""
-    cos_psi = min(1.0, max(-1.0, ux * sf[p] + uy * sf[p + 1] + uz * sf[p + 2]))
+    cos_psi = min(1.0, max(-1.0, ux * floats[p] + uy * floats[p + 1] + uz * floats[p + 2]))
     psi = math.acos(cos_psi)
     horizon = 1.0 - math.exp(-0.19 / uz) if uz > 0.0 else 1.0
-    return ((1.63 + 53.7 * math.exp(-5.49 * psi) + 2.04 * cos_psi * cos_psi * sf[p + 3])
-            * horizon * (1.0 - math.exp(-0.53 / sf[p + 3])))
+    return ((1.63 + 53.7 * math.exp(-5.49 * psi) + 2.04 * cos_psi * cos_psi * floats[p + 3])
+            * horizon * (1.0 - math.exp(-0.53 / floats[p + 3])))
 
 
 @kernel
-def sky_direction(sky, sf, rng):
+def sky_direction(sky, floats, rng):
     """(ux, uy, uz, weight factor) of a sky photon's travel direction. Tabulated skies: a row by
     the marginal CDF, a cell by the row's conditional CDF, sin^2(theta) and phi uniform within
     the cell (density exactly proportional to the cell's L cos); the map gives the view
@@ -52,27 +52,27 @@ def sky_direction(sky, sf, rng):
         n_cols = sky.n_cols
         if model == SKY_MAP_COSINE:
             s = uniform(rng)
-            phi_view = sf[sky.phi_edges] + 2.0 * math.pi * uniform(rng)
+            phi_view = floats[sky.phi_edges] + 2.0 * math.pi * uniform(rng)
             # the cell holding (s, phi_view), edge[i] <= value < edge[i + 1]; the final edge is
             # not read (the last cell if rounding puts phi_view on it)
-            row = interval(sf, sky.s_edges, -1, sky.n_rows, s)
-            col = interval(sf, sky.phi_edges, -1, n_cols, phi_view)
+            row = interval(floats, sky.s_edges, -1, sky.n_rows, s)
+            col = interval(floats, sky.phi_edges, -1, n_cols, phi_view)
         else:
             # the row and cell with cdf[i - 1] <= u < cdf[i], cdf[-1] = 0; the last entry, 1, is
             # not read
-            row = interval(sf, sky.row_cdf, -1, sky.n_rows - 1, uniform(rng)) + 1
-            col = interval(sf, sky.cell_cdf + row * n_cols, -1, n_cols - 1, uniform(rng)) + 1
-            s0 = sf[sky.s_edges + row]
-            s = s0 + uniform(rng) * (sf[sky.s_edges + row + 1] - s0)
-            p0 = sf[sky.phi_edges + col]
-            phi_view = p0 + uniform(rng) * (sf[sky.phi_edges + col + 1] - p0)
+            row = interval(floats, sky.row_cdf, -1, sky.n_rows - 1, uniform(rng)) + 1
+            col = interval(floats, sky.cell_cdf + row * n_cols, -1, n_cols - 1, uniform(rng)) + 1
+            s0 = floats[sky.s_edges + row]
+            s = s0 + uniform(rng) * (floats[sky.s_edges + row + 1] - s0)
+            p0 = floats[sky.phi_edges + col]
+            phi_view = p0 + uniform(rng) * (floats[sky.phi_edges + col + 1] - p0)
         sin_t = math.sqrt(min(1.0, max(0.0, s)))
         uz = math.sqrt(max(0.0, 1.0 - s))
         ux = -sin_t * math.cos(phi_view)
         uy = -sin_t * math.sin(phi_view)
-        cell_l = sf[sky.cell_l + row * n_cols + col]
+        cell_l = floats[sky.cell_l + row * n_cols + col]
         if model == SKY_HARRISON_COOMBES:
-            return ux, uy, uz, harrison_coombes(sf, sky.params, ux, uy, uz) / cell_l
+            return ux, uy, uz, harrison_coombes(floats, sky.params, ux, uy, uz) / cell_l
         if model == SKY_MAP_COSINE:
             return ux, uy, uz, cell_l
         return ux, uy, uz, 1.0
@@ -82,13 +82,13 @@ def sky_direction(sky, sf, rng):
 
 
 @setup
-def sky_many(sky_record, sf, n, rng):
+def sky_many(sky_record, floats, n, rng):
     """Rows (ux, uy, uz, weight factor) of n sky photons drawn from the stream rng (tests and
     reports)."""
     sky = sky_record[0]
     out = np.empty((n, 4))
     for k in range(n):
-        ux, uy, uz, m = sky_direction(sky, sf, rng)
+        ux, uy, uz, m = sky_direction(sky, floats, rng)
         out[k, 0] = ux
         out[k, 1] = uy
         out[k, 2] = uz

@@ -28,15 +28,15 @@ def theta_band(uz, mu_edges):
 
 
 @kernel
-def theta_band_fast(grid, gf, gi, uz):
+def theta_band_fast(grid, floats, ints, uz):
     """theta_band by table: theta_lookup[k] is the band of the top of the k-th of M equal cells
     of uz in [-1, 1]; lower values in the same cell can only be in that band or a later one, so
     a short walk down the edges finishes the job exactly."""
     m = grid.n_lookup
     k = min(m - 1, int((uz + 1.0) * (0.5 * m)))
-    band = gi[grid.theta_lookup + k]
+    band = ints[grid.theta_lookup + k]
     last = grid.n_theta - 1
-    while band < last and uz <= gf[grid.theta_mu_edges + band + 1]:
+    while band < last and uz <= floats[grid.theta_mu_edges + band + 1]:
         band += 1
     return band
 
@@ -50,7 +50,7 @@ def phi_band(ux, uy, n_phi):
 
 
 @kernel
-def phi_band_fast(grid, gf, ux, uy):
+def phi_band_fast(grid, floats, ux, uy):
     """phi_band without atan2: a polynomial guess of the azimuth (error < 0.0038 rad; Rajan et
     al. 2006, IEEE Signal Process. Mag. 23(3)). The bands are equal, so a guess farther than
     0.0063 rad (0.001 n bands) from an edge is the band; near an edge, exact tests against the
@@ -79,11 +79,11 @@ def phi_band_fast(grid, gf, ux, uy):
     # band k lies between edge k (inclusive) and edge k + 1 (exclusive), counterclockwise
     cos_at = grid.phi_edge_cos
     sin_at = grid.phi_edge_sin
-    while gf[cos_at + k] * uy - gf[sin_at + k] * ux < 0.0:
+    while floats[cos_at + k] * uy - floats[sin_at + k] * ux < 0.0:
         k = k - 1 if k > 0 else n - 1
     while True:
         up = k + 1 if k + 1 < n else 0
-        if gf[cos_at + up] * uy - gf[sin_at + up] * ux < 0.0:
+        if floats[cos_at + up] * uy - floats[sin_at + up] * ux < 0.0:
             return k
         k = up
 
@@ -121,7 +121,7 @@ def score(grid, tally, ps, index, w):
 
 
 @kernel
-def score_crossing(grid, gf, gi, tally, ps, level, w, ux, uy, uz, beam):
+def score_crossing(grid, floats, ints, tally, ps, level, w, ux, uy, uz, beam):
     """A crossing of tally level `level` (an in-water depth, or one of the air levels after
     them) by a packet of spectral state ps; beam: the packet is still part of the collimated
     solar beam."""
@@ -131,8 +131,8 @@ def score_crossing(grid, gf, gi, tally, ps, level, w, ux, uy, uz, beam):
     scalar = at + (FLUX_EOD if uz > 0.0 else FLUX_EOU)
     quad = -1
     if grid.radiance_on:
-        band = theta_band_fast(grid, gf, gi, uz)
-        col = 0 if gi[grid.theta_is_cap + band] else phi_band_fast(grid, gf, ux, uy)
+        band = theta_band_fast(grid, floats, ints, uz)
+        col = 0 if ints[grid.theta_is_cap + band] else phi_band_fast(grid, floats, ux, uy)
         quad = grid.radiance + (level * grid.theta_cols + band) * grid.phi_cols + col
     if grid.n_wl == 1:
         tally[plane] += w

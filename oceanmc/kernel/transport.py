@@ -6,11 +6,11 @@ trace_batch's event loop (move to the next event, then handle it, as MC/DC's loo
 free_flight (to the next collision or plane), collide, cross_plane, and on the surface
 leave_or_reflect, on the bottom reflect_at_bottom, after either after_reflection; a packet from
 the air meets the surface in enter_from_air. Only trace_batch sees the whole scene; each event
-takes the component records and pools it needs (kernel/records.py) and the packet (kernel/
-packet.py: a PACKET record p and its spectral state ps), which it updates in place. A
-collision that scatters runs one of the scene's collision channels (kernel/channels/). The event functions carry LLVM's alwaysinline attribute
-(kernel/compile.py): compiled once each, they are merged into the loop by LLVM, not copied by
-Numba.
+takes the component records it needs, the scene's float and int pools (kernel/records.py) and
+the packet (kernel/packet.py: a PACKET record p and its spectral state ps), which it updates in
+place. A collision that scatters runs one of the scene's collision channels (kernel/channels/).
+The event functions carry LLVM's alwaysinline attribute (kernel/compile.py): compiled once
+each, they are merged into the loop by LLVM, not copied by Numba.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -101,13 +101,13 @@ def facet_walk(surface, p, rng):
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
+def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
     air = grid.air_level
     w = p.w
-    score_crossing(grid, gf, gi, tally, ps, air, w, p.ux, p.uy, p.uz, p.beam)
+    score_crossing(grid, floats, ints, tally, ps, air, w, p.ux, p.uy, p.uz, p.beam)
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
@@ -121,7 +121,7 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
         w_reflected = w * r
         p.w = w * (1.0 - r)
     if w_reflected > 0.0:
-        score_crossing(grid, gf, gi, tally, ps, air, w_reflected, rx, ry, rz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, air, w_reflected, rx, ry, rz, p.beam)
         score(grid, tally, ps, grid.budget + BUDGET_SURFACE_REFLECTION, w_reflected)
     if reflected or p.w <= 0.0:
         return False
@@ -129,45 +129,45 @@ def enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
     p.uy = ty
     p.uz = tz
     if grid.surface_level >= 0:
-        score_crossing(grid, gf, gi, tally, ps, grid.surface_level, p.w, tx, ty, tz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, grid.surface_level, p.w, tx, ty, tz, p.beam)
     return True
 
 
 @internal
-def free_flight(medium, mf, mi, ctrl, grid, tally, ps, p, tau, rng):
+def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
     """Moves the packet through its segment with tau optical depths left to its next
     collision: (FLIGHT_COLLISION, layer, 0) at a collision, (FLIGHT_PLANE, plane, tau left) on
     reaching the plane ahead, or (FLIGHT_GONE, -1, 0) when a layer that does not scatter
     absorbs it or it leaves down an infinitely deep one (attenuation there is exact: weight
     times exp(-c dist), or survival with that probability in the analog walk)."""
     seg = p.seg
-    layer = mi[medium.segment_layer + seg]
+    layer = ints[medium.segment_layer + seg]
     at = layer * medium.n_wl + p.wavelength
-    c = mf[medium.layer_c + at]
-    albedo = mf[medium.layer_albedo + at]
+    c = floats[medium.layer_c + at]
+    albedo = floats[medium.layer_albedo + at]
     uz = p.uz
     if uz > 0.0:
         target = seg + 1
-        dist = (mf[medium.plane_z + target] - p.z) / uz
+        dist = (floats[medium.plane_z + target] - p.z) / uz
     elif uz < 0.0:
         target = seg
-        dist = (mf[medium.plane_z + target] - p.z) / uz
+        dist = (floats[medium.plane_z + target] - p.z) / uz
     else:
         target = -1
         dist = math.inf
     budget = grid.budget
     if albedo > 0.0:
-        s = tau * mf[medium.layer_inv_c + at]
+        s = tau * floats[medium.layer_inv_c + at]
         if s < dist:
             p.z += s * uz
             if grid.n_wl > 1:
-                spectral.fly(medium, mf, grid, ps, p, layer, s)
+                spectral.fly(medium, floats, grid, ps, p, layer, s)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
         if grid.n_wl > 1 and dist < math.inf:
-            spectral.fly(medium, mf, grid, ps, p, layer, dist)
+            spectral.fly(medium, floats, grid, ps, p, layer, dist)
     elif grid.n_wl > 1:
-        if spectral.attenuate(medium, mf, grid, tally, ps, p, layer, dist):
+        if spectral.attenuate(medium, floats, grid, tally, ps, p, layer, dist):
             return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
         # no scattering and no plane ahead: down an infinitely deep clear layer, or level
@@ -183,24 +183,24 @@ def free_flight(medium, mf, mi, ctrl, grid, tally, ps, p, tau, rng):
             tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
             p.w *= transmitted
     if grid.n_wl > 1:
-        spectral.settle(medium, mf, grid, tally, ps, p, layer)
+        spectral.settle(medium, floats, grid, tally, ps, p, layer)
     if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
         score(grid, tally, ps, budget + BUDGET_LOST_BELOW, p.w)
         return FLIGHT_GONE, -1, 0.0
-    p.z = mf[medium.plane_z + target]
+    p.z = floats[medium.plane_z + target]
     return FLIGHT_PLANE, target, tau
 
 
 @internal
-def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, ps, work, p, layer,
-            events, rng):
+def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, p, layer, events,
+            rng):
     """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
     one of the scene's collision channels (kernel/channels/) by its share of the scattering,
     roulette. Returns (alive, optical depth to the next collision)."""
-    albedo = mf[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
+    albedo = floats[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
     if est.directions_on or est.cap_on:   # (a spectral walk settles there: p.w may change)
-        local_estimate.at_collision(est, ef, ei, grid, gf, medium, mf, mi, surface, tally, ps,
-                                    work, p, layer, p.w * albedo, rng)
+        local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
+                                    p, layer, p.w * albedo, rng)
     w = p.w
     budget = grid.budget
     if ctrl.analog:
@@ -215,25 +215,25 @@ def collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei, tally, ps, wor
         if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
             tally[budget + BUDGET_LAYERS + layer] += w - scattered
         p.w = scattered
-    channel = channels.choose(medium, mf, layer, p.wavelength, rng)
-    channels.scatter(channel, medium, mf, mi, ctrl, grid, tally, ps, work, p, layer, rng)
+    channel = channels.choose(medium, floats, layer, p.wavelength, rng)
+    channels.scatter(channel, medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
     p.beam = 0
     tau = exponential(rng)
     if grid.n_wl > 1:
-        if not spectral.survives_roulette(medium, mf, ctrl, grid, tally, ps, p, layer, rng):
+        if not spectral.survives_roulette(medium, floats, ctrl, grid, tally, ps, p, layer, rng):
             return False, tau
     elif not survives_roulette(ctrl, p, rng):
         return False, tau
     if events >= ctrl.max_events:
         if grid.n_wl > 1:
-            spectral.settle(medium, mf, grid, tally, ps, p, layer)
+            spectral.settle(medium, floats, grid, tally, ps, p, layer)
         score(grid, tally, ps, budget + BUDGET_TRUNCATED, p.w)
         return False, tau
     return True, tau
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
+def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -252,8 +252,8 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
         goes_on = r > 0.0 and (r >= 1.0 or uniform(rng) < r)
     if leaving > 0.0:
         air = grid.air_level
-        score_crossing(grid, gf, gi, tally, ps, air, leaving, tx, ty, tz, p.beam)
-        score_crossing(grid, gf, gi, tally, ps, air + 1, leaving, tx, ty, tz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, air, leaving, tx, ty, tz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, air + 1, leaving, tx, ty, tz, p.beam)
         score(grid, tally, ps, grid.budget + BUDGET_WATER_LEAVING, leaving)
     if not goes_on:
         return False
@@ -267,7 +267,7 @@ def leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
 
 
 @internal
-def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, ei, tally, ps,
+def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp, tally, ps,
                       work, p, rng):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
@@ -277,7 +277,7 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
         score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)
         return False
     if est.directions_on or est.cap_on:
-        local_estimate.at_bottom(est, ef, ei, grid, gf, medium, mf, bottom, bp, surface, tally,
+        local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
                                  ps, work, p, rng)
     ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, uniform(rng),
                                    uniform(rng))
@@ -293,9 +293,9 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
                 tally[budget + BUDGET_BOTTOM] += p.w
             return False
         if grid.n_wl > 1:
-            spectral.reflect(grid, gf, tally, ps, p, 1.0)
+            spectral.reflect(grid, floats, tally, ps, p, 1.0)
     elif grid.n_wl > 1:
-        spectral.reflect(grid, gf, tally, ps, p, rho)
+        spectral.reflect(grid, floats, tally, ps, p, rho)
     else:
         tally[budget + BUDGET_BOTTOM] += p.w * (1.0 - rho)
         p.w *= rho
@@ -304,13 +304,13 @@ def reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf, est, ef, 
 
 
 @internal
-def cross_plane(medium, mi, grid, gf, gi, tally, ps, p, target):
+def cross_plane(medium, grid, floats, ints, tally, ps, p, target):
     """The packet is on plane `target`: scored if the plane is a tally level; returns what the
     plane is (PLANE_SURFACE, PLANE_BOTTOM, or PLANE_INSIDE, where the packet has gone on into
     the next segment) and the plane's tally level (-1: none)."""
-    level = mi[medium.plane_tally + target]
+    level = ints[medium.plane_tally + target]
     if level >= 0:
-        score_crossing(grid, gf, gi, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if target == 0:
         return PLANE_SURFACE, level
     if target == medium.n_planes - 1:
@@ -320,24 +320,24 @@ def cross_plane(medium, mi, grid, gf, gi, tally, ps, p, target):
 
 
 @internal
-def after_reflection(medium, mf, mi, ctrl, grid, gf, gi, tally, ps, stack, stack_ps, n_stacked,
-                     p, level, rng):
+def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_ps, n_stacked, p,
+                     level, rng):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
-        score_crossing(grid, gf, gi, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
+        score_crossing(grid, floats, ints, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
         n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
     if grid.n_wl > 1:
-        return spectral.survives_roulette(medium, mf, ctrl, grid, tally, ps, p,
-                                          mi[medium.segment_layer + p.seg], rng), n_stacked
+        return spectral.survives_roulette(medium, floats, ctrl, grid, tally, ps, p,
+                                          ints[medium.segment_layer + p.seg], rng), n_stacked
     return survives_roulette(ctrl, p, rng), n_stacked
 
 
 @batch
-def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, grid_row, gf, gi,
-                est_row, ef, ei, ctrl_row, n_photons, start, work_budget, rng, beam_in, tally,
-                packet_row, stack, states, work):
+def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
+                floats, ints, n_photons, start, work_budget, rng, beam_in, tally, packet_row,
+                stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
@@ -352,9 +352,11 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
     scratch (records.work_size). The sky's share is stratified: round(f n)
     packets come from the sky and carry f n / n_sky each, the rest from the sun. A photon's
     split copies (stack) are traced before the next photon. The records come as one-row
-    arrays; the GIL is released, so batches run in parallel threads."""
+    arrays, the scene's tables as one float pool and one int pool (kernel/records.py); the GIL
+    is released, so batches run in parallel threads."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
     grid, est, ctrl, p = grid_row[0], est_row[0], ctrl_row[0], packet_row[0]
+    bp = floats[bottom.params:]   # the BRDF's parameters, at offsets of their own
     ps = states[0]
     stack_ps = states[1:]
     f = sky.diffuse_fraction
@@ -384,7 +386,7 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
                 continue
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun * n_sun
         elif from_sky:
-            ux, uy, uz, weight = sky_direction(sky, sf, rng)
+            ux, uy, uz, weight = sky_direction(sky, floats, rng)
             w = weight * w_sky
         elif not beam_once:
             ux, uy, uz, w = sky.sun_sin, 0.0, sky.sun_mu, w_sun
@@ -393,8 +395,8 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
         packet.launch(p, w, ux, uy, uz, not from_sky)
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
-            spectral.start(grid, gf, ps, p, from_sky, rng)
-        if from_air and not enter_from_air(surface, ctrl, grid, gf, gi, tally, ps, p, rng):
+            spectral.start(grid, floats, ps, p, from_sky, rng)
+        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
@@ -411,22 +413,23 @@ def trace_batch(medium_row, mf, mi, surface_row, bottom_row, bp, sky_row, sf, gr
             alive = True
             walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
-                outcome, where, tau = free_flight(medium, mf, mi, ctrl, grid, tally, ps, p,
+                outcome, where, tau = free_flight(medium, ctrl, grid, floats, ints, tally, ps, p,
                                                   tau, rng)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
-                    alive, tau = collide(medium, mf, mi, surface, ctrl, grid, gf, est, ef, ei,
-                                         tally, ps, work, p, where, walk_events, rng)
+                    alive, tau = collide(medium, surface, ctrl, grid, est, floats, ints, tally,
+                                         ps, work, p, where, walk_events, rng)
                 elif outcome == FLIGHT_PLANE:
-                    plane, level = cross_plane(medium, mi, grid, gf, gi, tally, ps, p, where)
+                    plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
-                        alive = leave_or_reflect(surface, ctrl, grid, gf, gi, tally, ps, p, rng)
+                        alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
+                                                 rng)
                     elif plane == PLANE_BOTTOM:
-                        alive = reflect_at_bottom(medium, mf, surface, bottom, bp, ctrl, grid, gf,
-                                                  est, ef, ei, tally, ps, work, p, rng)
+                        alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
+                                                  floats, ints, bp, tally, ps, work, p, rng)
                     if alive and plane != PLANE_INSIDE:
-                        alive, n_stacked = after_reflection(medium, mf, mi, ctrl, grid, gf,
-                                                            gi, tally, ps, stack, stack_ps,
+                        alive, n_stacked = after_reflection(medium, ctrl, grid, floats, ints,
+                                                            tally, ps, stack, stack_ps,
                                                             n_stacked, p, level, rng)
                 else:
                     alive = False

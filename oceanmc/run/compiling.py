@@ -15,6 +15,7 @@ If the child fails or is slow, trace_batch compiles that part itself: the result
 """
 from __future__ import annotations
 
+import inspect
 import os
 import subprocess
 import sys
@@ -45,37 +46,41 @@ class CompileInterrupted(Exception):
     """The user asked to stop while the kernel was compiling; nothing was traced."""
 
 
-def _record(dtype):
-    return numba.typeof(np.zeros(1, dtype=dtype)).dtype
+def _argument_types() -> dict[str, numba.types.Type]:
+    """The Numba type of each kernel argument by its name, the same in every kernel function
+    (a record by its component's name, its one-row array by name_row, the scene's pools
+    `floats` and `ints`, the packet p and its spectral state ps, ...)."""
+    f8 = numba.typeof(np.zeros(1))
+    types = {"floats": f8, "ints": numba.typeof(np.zeros(1, dtype=np.int64)),
+             "bp": f8, "tally": f8, "ps": f8, "work": f8, "beam_in": f8, "angles": f8,
+             "states": numba.typeof(np.zeros((1, 1))),
+             "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "layer": numba.int64, "events": numba.int64, "wavelength": numba.int64,
+             "n_photons": numba.int64, "start": numba.int64, "work_budget": numba.int64,
+             "mu": numba.float64}
+    for name, dtype in (("medium", records.MEDIUM), ("surface", records.SURFACE),
+                        ("bottom", records.BOTTOM), ("sky", records.SKY), ("grid", records.GRID),
+                        ("est", records.ESTIMATES), ("ctrl", records.ESTIMATOR),
+                        ("packet", records.PACKET)):
+        row = numba.typeof(np.zeros(1, dtype=dtype))
+        types[name], types[f"{name}_row"] = row.dtype, row
+    types["p"], types["stack"] = types["packet"], types["packet_row"]
+    return types
+
+
+def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
+    """The argument types of a kernel function, from its parameters' names."""
+    return tuple(types[name] for name in inspect.signature(function.py_func).parameters)
 
 
 def parts() -> dict[str, list[tuple]]:
     """(dispatcher, argument types) to compile, in order: `bottom` (in the child process when
     there is one), `water` and `entry` (the entry points, trace_batch first) here."""
-    f8, i8 = numba.typeof(np.zeros(1)), numba.typeof(np.zeros(1, dtype=np.int64))
-    u8 = numba.typeof(np.zeros(1, dtype=np.uint64))
-    f8_rows = numba.typeof(np.zeros((1, 1)))
-    medium, surface, bottom, sky, grid, est, ctrl, packet = (
-        _record(d) for d in (records.MEDIUM, records.SURFACE, records.BOTTOM, records.SKY,
-                             records.GRID, records.ESTIMATES, records.ESTIMATOR, records.PACKET))
-    rows = [numba.types.Array(r, 1, "C") for r in (medium, surface, bottom, sky, grid, est, ctrl,
-                                                   packet)]
-    row_medium, row_surface, row_bottom, row_sky, row_grid, row_est, row_ctrl, row_packet = rows
-    int64, float64 = numba.int64, numba.float64
-    return {
-        "bottom": [(transport.reflect_at_bottom, (medium, f8, surface, bottom, f8, ctrl, grid,
-                                                  f8, est, f8, i8, f8, f8, f8, packet, u8))],
-        "water": [(transport.collide, (medium, f8, i8, surface, ctrl, grid, f8, est, f8, i8, f8,
-                                       f8, f8, packet, int64, int64, u8)),
-                  (transport.enter_from_air, (surface, ctrl, grid, f8, i8, f8, f8, packet, u8)),
-                  (transport.leave_or_reflect, (surface, ctrl, grid, f8, i8, f8, f8, packet,
-                                                u8))],
-        "entry": [(trace_batch, (row_medium, f8, i8, row_surface, row_bottom, f8, row_sky, f8,
-                                 row_grid, f8, i8, row_est, f8, i8, row_ctrl, int64, int64, int64,
-                                 u8, f8, f8, row_packet, row_packet, f8_rows, f8)),
-                  (layer_density, (medium, f8, i8, int64, int64, f8)),
-                  (transmittance, (surface, float64))],
-    }
+    types = _argument_types()
+    return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
+        ("bottom", (transport.reflect_at_bottom,)),
+        ("water", (transport.collide, transport.enter_from_air, transport.leave_or_reflect)),
+        ("entry", (trace_batch, layer_density, transmittance)))}
 
 
 def compile_part(name: str) -> None:

@@ -1,6 +1,7 @@
 """Config -> the kernel's records and pools: one packer per component (medium, surface, bottom,
-sky, tally grid, local estimates), each producing its record (kernel/records.py), in one pass.
-No Python object crosses into the kernel."""
+sky, tally grid, local estimates), each producing its record (kernel/records.py) and pools of its
+own, which build() merges into the scene's one float pool and one int pool. No Python object
+crosses into the kernel."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -9,39 +10,32 @@ import numpy as np
 
 from .. import config as cfg
 from .. import optics
-from ..kernel.records import ESTIMATOR, record
+from ..kernel.records import ESTIMATOR, merge, record
 from . import bottom, estimates, grid, medium, sky, surface
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
 
 @dataclass(frozen=True)
 class Scene:
-    """The packed scene: records (one-row arrays of the kernel/records.py dtypes) and pools, in
-    the order the photon loop takes them (kernel_args), the angular grid, and for each requested
-    local direction its (water row, air row)."""
+    """The packed scene: records (one-row arrays of the kernel/records.py dtypes) and the two
+    pools, in the order the photon loop takes them (kernel_args), the angular grid, and for
+    each requested local direction its (water row, air row)."""
     medium: np.ndarray
-    mf: np.ndarray
-    mi: np.ndarray
     surface: np.ndarray
     bottom: np.ndarray
-    bp: np.ndarray
     sky: np.ndarray
-    sf: np.ndarray
     grid: np.ndarray
-    gf: np.ndarray
-    gi: np.ndarray
     estimates: np.ndarray
-    ef: np.ndarray
-    ei: np.ndarray
     estimator: np.ndarray
+    floats: np.ndarray
+    ints: np.ndarray
     angles: Grid
     local_rows: list
     layers: tuple               # optics.LayerIOPs of each kernel layer
 
     def kernel_args(self) -> tuple:
-        return (self.medium, self.mf, self.mi, self.surface, self.bottom, self.bp, self.sky,
-                self.sf, self.grid, self.gf, self.gi, self.estimates, self.ef, self.ei,
-                self.estimator)
+        return (self.medium, self.surface, self.bottom, self.sky, self.grid, self.estimates,
+                self.estimator, self.floats, self.ints)
 
     @property
     def tally_size(self) -> int:
@@ -77,9 +71,11 @@ def build(config: cfg.SceneConfig) -> Scene:
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
                                    len(directions[0]), len(column.albedo))
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
-    return Scene(med, mf, mi, surf, bot, bp, sk, sf, gr, gf, gi, est, ef, ei,
-                 pack_estimator(config.estimator, column.albedo), angles, local_rows,
-                 column.layers)
+    no_ints = np.zeros(0, dtype=np.int64)
+    (med, bot, sk, gr, est), floats, ints = merge(
+        [(med, mf, mi), (bot, bp, no_ints), (sk, sf, no_ints), (gr, gf, gi), (est, ef, ei)])
+    return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column.albedo),
+                 floats, ints, angles, local_rows, column.layers)
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]

@@ -10,8 +10,9 @@ from . import brdf_tables
 
 
 def pack(bottom) -> tuple[np.ndarray, np.ndarray]:
+    """(BOTTOM record, its float pool: the BRDF's parameters from offset 0)."""
     model, params = brdf_tables.bottom_arrays(bottom)
     rec = record(BOTTOM, model=model,
                  reflects=int(model not in (models.BOTTOM_NONE, models.BOTTOM_BLACK)),
-                 mirror=int(model == models.BOTTOM_SPECULAR))
+                 mirror=int(model == models.BOTTOM_SPECULAR), params=0)
     return rec, params

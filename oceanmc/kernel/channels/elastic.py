@@ -12,38 +12,39 @@ from ..rng import uniform
 
 
 @internal
-def scatter(medium, mf, mi, ctrl, grid, tally, ps, work, p, layer, rng):
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
     """The packet's new direction, and its weights for it (see channels/__init__.py)."""
     ux, uy, uz = p.ux, p.uy, p.uz
     h = p.wavelength
     spectral_walk = grid.n_wl > 1
     psi_s = -1
     node_s = -1
-    toward_up = ctrl.upward != 0 and uniform(rng) < mf[medium.up_fraction + layer]
+    toward_up = ctrl.upward != 0 and uniform(rng) < floats[medium.up_fraction + layer]
     if toward_up:
         nx, ny, nz = upward.cone_direction(medium, rng)
         cos_s = ux * nx + uy * ny + uz * nz
         angle = tabulated.clamped_angle(cos_s)
     else:
-        u_pick = uniform(rng) if mi[medium.comp_count + layer] > 1 else 0.0
+        u_pick = uniform(rng) if ints[medium.comp_count + layer] > 1 else 0.0
         if spectral_walk:
-            k_s = phase.pick(medium, mf, mi, layer, h, u_pick)
-            cos_s, angle, psi_s, node_s = phase.sample_angle(medium, mf, mi, k_s, uniform(rng))
+            k_s = phase.pick(medium, floats, ints, layer, h, u_pick)
+            cos_s, angle, psi_s, node_s = phase.sample_angle(medium, floats, ints, k_s,
+                                                             uniform(rng))
         else:
-            cos_s = phase.sample_cos(medium, mf, mi, layer, h, u_pick, uniform(rng))
+            cos_s = phase.sample_cos(medium, floats, ints, layer, h, u_pick, uniform(rng))
             angle = 0.0
         nx, ny, nz = turn(ux, uy, uz, cos_s, uniform(rng))
-    if ctrl.upward:
-        if spectral_walk:
-            inside = -nz > medium.up_cos
-            spectral.scatter_weights(medium, mf, mi, grid, tally, ps, work, p, layer, cos_s,
-                                     angle, psi_s, node_s, mf[medium.up_keep + layer],
-                                     mf[medium.up_density + layer] if inside else 0.0)
-        else:
-            p.w = upward.weight(medium, mf, mi, layer, p.w, ux * nx + uy * ny + uz * nz, nz)
-    elif spectral_walk:
-        spectral.scatter_weights(medium, mf, mi, grid, tally, ps, work, p, layer, cos_s, angle,
-                                 psi_s, node_s, 1.0, 0.0)
+    if spectral_walk:
+        keep = 1.0
+        cone_density = 0.0
+        if ctrl.upward:
+            keep = floats[medium.up_keep + layer]
+            if -nz > medium.up_cos:
+                cone_density = floats[medium.up_density + layer]
+        spectral.scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s,
+                                 angle, psi_s, node_s, keep, cone_density, ctrl.analog != 0)
+    elif ctrl.upward:
+        p.w = upward.weight(medium, floats, ints, layer, p.w, ux * nx + uy * ny + uz * nz, nz)
     p.ux = nx
     p.uy = ny
     p.uz = nz

@@ -1,6 +1,8 @@
 """Validation case spectral_history: all wavelengths in one photon history (kernel/spectral.py)
 against an independent single-wavelength run of the same scene at each wavelength, for a clear
-Case-1 water, a turbid coastal water and a shallow bottom; energy closure at every wavelength."""
+Case-1 water, a turbid coastal water and a shallow bottom; energy closure at every wavelength;
+the spectral walk's other estimators (upward bias, splitting, analog) against the same
+single-wavelength runs over the bottom."""
 from __future__ import annotations
 
 import numpy as np
@@ -36,6 +38,14 @@ QUANTITIES = (("Ed", "Ed", True, (0.05, 0.2)), ("Eu", "Eu", True, (0.05, 0.2)),
               ("air/Rrs_nadir", "Rrs nadir (local estimate)", False, (0.05, 0.2)),
               ("air/Rrs_nadir_crossing", "Rrs nadir (crossing)", False, (0.1, 0.35)),
               ("budget/water_leaving", "budget water_leaving", False, (0.05, 0.2)))
+
+
+# the spectral walk's other estimators, over the bottom, each against the default walk's
+# single-wavelength runs
+ESTIMATORS = (("upward bias 0.1", {"upward_fraction": 0.1}),
+              ("splitting above weight 1.05", {"split_weight": 1.05}),
+              ("analog walk", {"mode": "analog"}))
+ESTIMATOR_QUANTITIES = ("Ed", "Eu", "Lu", "air/Rrs_nadir", "budget/water_leaving")
 
 
 def spectral_config(name: str, photons: int, layers: list, bottom: dict, depths: list,
@@ -78,6 +88,7 @@ def case_spectral_history(ctx: Ctx) -> None:
                     spectral["budget/total"], spectral.stderr("budget/total"), 1.0,
                     labels=[f"{wl:g} nm" for wl in WAVELENGTHS])
         figure_data.append((name, spectral, singles))
+    compare_estimators(ctx, photons, singles)
     plt = _plt()
     fig, axes = plt.subplots(1, len(figure_data), figsize=(12, 3.6))
     for ax, (name, spectral, singles) in zip(axes, figure_data):
@@ -103,7 +114,35 @@ def case_spectral_history(ctx: Ctx) -> None:
              "the same collisions) at every depth, Eu(0+), Rrs nadir (local and crossing "
              "estimates in both) and the water-leaving fraction at every wavelength, z against "
              "both standard errors (Bonferroni bound per group); energy "
-             "closure: the budget adds up to 1 at every wavelength.")
+             "closure: the budget adds up to 1 at every wavelength. Over the bottom, the "
+             "one-history walk is also run with the upward bias, with splitting of packets "
+             "heavier than 1.05 (the split stack carries each copy's spectral state) and as "
+             "the analog walk (the hero's absorption and reflections drawn), each against the "
+             "same single-wavelength runs of the default walk.")
+
+
+def compare_estimators(ctx: Ctx, photons: int, singles: list) -> None:
+    """The last scene (the bottom) by each of ESTIMATORS in one history, against its default
+    single-wavelength runs, and its energy closure."""
+    name, layers, bottom, depths = SCENES[-1]
+    for label, estimator in ESTIMATORS:
+        config = spectral_config(f"{name}, {len(WAVELENGTHS)} wavelengths, {label}", photons,
+                                 layers, bottom, depths, WAVELENGTHS)
+        config["estimator"] = dict(estimator)
+        run = ctx.simulate(config)
+        for quantity in ESTIMATOR_QUANTITIES:
+            per_depth = run[quantity].ndim > 1
+            labels = [f"{wl:g} nm" + (f" z {d:g} m" if per_depth else "")
+                      for wl in WAVELENGTHS for d in (depths if per_depth else [None])]
+            ctx.compare(f"{name}, {label}: {quantity}, one history vs one run per wavelength",
+                        run[quantity].ravel(), run.stderr(quantity).ravel(),
+                        np.array([s[quantity] for s in singles]).ravel(),
+                        ref_error=np.array([s.stderr(quantity) for s in singles]).ravel(),
+                        labels=labels, rel_cap=ctx.pick(0.08, 0.3))
+        # the analog walk plays no roulette: every photon closes its budget, to rounding
+        ctx.compare(f"{name}, {label}: energy closure per wavelength", run["budget/total"],
+                    np.maximum(run.stderr("budget/total"), 1e-12), 1.0,
+                    labels=[f"{wl:g} nm" for wl in WAVELENGTHS])
 
 
 CASE = Case("spectral_history", "All wavelengths in one photon history", case_spectral_history,
