@@ -374,17 +374,6 @@ def reflect(grid, floats, tally, ps, p, rho):
 
 
 @kernel
-def absorb_at_bottom(grid, tally, ps, p):
-    """The analog walk's bottom absorbs the packet (which settled on the bottom plane): every
-    wavelength's weight."""
-    _, g, _ = weights(grid, ps)
-    absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
-    w = p.w
-    for j in range(grid.n_wl):
-        tally[absorbed + j] += w * g[j]
-
-
-@kernel
 def survives_roulette(medium, floats, ctrl, grid, tally, ps, p, layer, rng):
     """Roulette after a collision, on the largest wavelength weight max_j F_j (as transport's
     survives_roulette on p.w): a packet with p.w at or above the threshold goes on untested;

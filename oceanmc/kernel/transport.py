@@ -171,16 +171,17 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
             return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
         # no scattering and no plane ahead: down an infinitely deep clear layer, or level
-        tally[budget + ((BUDGET_LAYERS + layer) if c > 0.0 else BUDGET_LOST_BELOW)] += p.w
+        score(grid, tally, ps, budget + ((BUDGET_LAYERS + layer) if c > 0.0
+                                         else BUDGET_LOST_BELOW), p.w)
         return FLIGHT_GONE, -1, 0.0
     elif c > 0.0:
         transmitted = math.exp(-c * dist)
         if ctrl.analog:
             if uniform(rng) >= transmitted:
-                tally[budget + BUDGET_LAYERS + layer] += p.w
+                score(grid, tally, ps, budget + BUDGET_LAYERS + layer, p.w)
                 return FLIGHT_GONE, -1, 0.0
         else:
-            tally[budget + BUDGET_LAYERS + layer] += p.w * (1.0 - transmitted)
+            score(grid, tally, ps, budget + BUDGET_LAYERS + layer, p.w * (1.0 - transmitted))
             p.w *= transmitted
     if grid.n_wl > 1:
         spectral.settle(medium, floats, grid, tally, ps, p, layer)
@@ -208,12 +209,12 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, p, 
             if grid.n_wl > 1:
                 spectral.lose(grid, tally, ps, layer)
             else:
-                tally[budget + BUDGET_LAYERS + layer] += w
+                score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w)
             return False, 0.0
     else:
         scattered = w * albedo
         if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
-            tally[budget + BUDGET_LAYERS + layer] += w - scattered
+            score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w - scattered)
         p.w = scattered
     channel = channels.choose(medium, floats, layer, p.wavelength, rng)
     channels.scatter(channel, medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
@@ -287,17 +288,14 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
     p.beam = 1 if (p.beam != 0 and bottom.mirror != 0) else 0
     if ctrl.analog:
         if uniform(rng) >= rho:
-            if grid.n_wl > 1:
-                spectral.absorb_at_bottom(grid, tally, ps, p)
-            else:
-                tally[budget + BUDGET_BOTTOM] += p.w
+            score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)   # (settled on the plane)
             return False
         if grid.n_wl > 1:
             spectral.reflect(grid, floats, tally, ps, p, 1.0)
     elif grid.n_wl > 1:
         spectral.reflect(grid, floats, tally, ps, p, rho)
     else:
-        tally[budget + BUDGET_BOTTOM] += p.w * (1.0 - rho)
+        score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w * (1.0 - rho))
         p.w *= rho
     p.seg = medium.n_planes - 2
     return True
