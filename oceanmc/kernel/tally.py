@@ -15,7 +15,7 @@ Spectral scenes (kernel/spectral.py) hold every score with its wavelengths side 
 of it."""
 import math
 
-from .compile import kernel
+from .compile import hot, kernel
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 from .search import interval
 from .packet import weights
@@ -106,7 +106,7 @@ def spectral_at(grid, index):
     return grid.scores + (index - grid.scores) * grid.n_wl
 
 
-@kernel
+@hot
 def score(grid, tally, ps, index, w):
     """Adds weight w to score `index` (its offset in one wavelength's layout), and in a
     spectral scene w times each wavelength's share q of the packet (ps: its spectral state,

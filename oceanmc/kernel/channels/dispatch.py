@@ -27,7 +27,8 @@ def choose(medium, floats, layer, h, rng):
 
 @internal
 def scatter(channel, medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
-    """Runs channel `channel` of the scene (its model: MEDIUM channel_model)."""
-    model = ints[medium.channel_model + channel]
-    if model == CHANNEL_ELASTIC:
+    """Runs channel `channel` of the scene (its model: MEDIUM channel_model). Channel 0 is
+    every scene's elastic scattering (scene/medium.py packs it first), run without reading
+    its model."""
+    if channel == 0 or ints[medium.channel_model + channel] == CHANNEL_ELASTIC:
         elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
