@@ -140,8 +140,8 @@ def test_bad_input_is_one_line_naming_the_key(data, message):
 def test_profile_table_with_negative_values_names_the_file(tmp_path):
     path = tmp_path / "chl.csv"
     path.write_text("depth_m,value\n0,0.1\n10,-0.2\n")
-    with pytest.raises(ConfigError, match=r"chl_mg_m3\.file: .*chl.csv: value = -0.2 at depth "
-                                          r"10 m; a profile must be >= 0"):
+    with pytest.raises(ConfigError, match=r"chl_mg_m3\.file: .*chl.csv: value = -0.2 at "
+                                          r"depth_m = 10; allowed: 0 \.\. 100 mg/m3"):
         optics.column_iops(scene([{"model": "chlorophyll", "chl_mg_m3": {
             "profile": "table", "file": str(path)}}]))
 

@@ -21,6 +21,10 @@ MIN_ANGLE_DEG = 0.001
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
 # Absorption and scattering coefficients: the most turbid natural waters reach ~1e3 1/m; larger
 # finite values (1e308) would overflow a + b and the optical depths.
-Coefficient = Annotated[float, Field(ge=0.0, le=1e6, allow_inf_nan=False)]
+MAX_COEFFICIENT = 1e6
+Coefficient = Annotated[float, Field(ge=0.0, le=MAX_COEFFICIENT, allow_inf_nan=False)]
+# Layer thicknesses and profile depths: larger finite values only overflow optical depths
+# (c x thickness) without meaning anything.
+MAX_THICKNESS_M = 1e6
 Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
 Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)]

@@ -3,16 +3,24 @@ and a phase function per wavelength; oceanmc/optics/components/ has one module p
 depth profiles a component's amount may follow (oceanmc/optics/profiles.py)."""
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal, Union
 
-from pydantic import AliasChoices, Discriminator, Field, Tag, model_validator
+from pydantic import (AfterValidator, AliasChoices, Discriminator, Field, PrivateAttr, Tag,
+                      model_validator)
 
-from .base import NonNegative, _Strict
+from .base import MAX_THICKNESS_M, Coefficient, NonNegative, _Strict
 from .phase import BasicPhase
-from .wavelengths import BackscatterRatio, Spectral, spectral
+from .wavelengths import BackscatterRatio, spectral
 
-Depth = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+Depth = Annotated[float, Field(ge=0.0, le=MAX_THICKNESS_M, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0.0, le=MAX_THICKNESS_M, allow_inf_nan=False)]
+# The ranges of the constituents' amounts: chlorophyll, the range the Case-1 models are published
+# for (Bricaud et al. 1998: 0.02-25 mg/m3; at 1e4 Morel et al. 2002's bb/b is negative); the
+# others generous natural bounds (the darkest or most turbid waters reach ~1e2-1e3 1/m).
+MAX_CHL_MG_M3 = 100.0
+MAX_CONSTITUENT = 1000.0      # a440, a443, b550 (1/m) and concentration (a factor)
+Constituent = Annotated[float, Field(ge=0.0, le=MAX_CONSTITUENT, allow_inf_nan=False)]
 
 
 class GaussianProfile(_Strict):
@@ -49,6 +57,8 @@ class TableProfile(_Strict):
     at the end values outside."""
     profile: Literal["table"]
     file: str
+    # (largest value, unit) of the key it profiles, set by amount(); checked when it is read
+    _limit: tuple[float, str] = PrivateAttr(default=(math.inf, ""))
 
 
 Profile = Annotated[Union[GaussianProfile, LinearProfile, TableProfile],
@@ -60,10 +70,28 @@ def _amount_kind(value) -> str:
         else "amount_value"
 
 
-# a component's amount: one number, or a profile over depth
-Amount = Annotated[Union[Annotated[NonNegative, Tag("amount_value")],
-                         Annotated[Profile, Tag("profile")]],
-                   Discriminator(_amount_kind)]
+def amount(limit: float, unit: str):
+    """A component's amount: one number, or a profile over depth, within 0 .. limit (a table
+    profile's values are checked when it is read, optics/profiles.py)."""
+    allowed = f"allowed: 0 .. {limit:g}{' ' + unit if unit else ''}"
+
+    def within(value):
+        if isinstance(value, TableProfile):
+            value._limit = (limit, unit)
+        elif isinstance(value, GaussianProfile):
+            peak = value.background + value.integral / (value.width_m * math.sqrt(2.0 * math.pi))
+            if peak > limit:
+                raise ValueError(f"the gaussian's peak, background + integral / (width_m "
+                                 f"sqrt(2 pi)), is {peak:g}; {allowed}")
+        elif isinstance(value, LinearProfile):
+            if max(value.values) > limit:
+                raise ValueError(f"values reach {max(value.values):g}; {allowed}")
+        elif value > limit:
+            raise ValueError(allowed)
+        return value
+    return Annotated[Union[Annotated[NonNegative, Tag("amount_value")],
+                           Annotated[Profile, Tag("profile")]],
+                     Discriminator(_amount_kind), AfterValidator(within)]
 
 
 class PureWaterComponent(_Strict):
@@ -78,13 +106,13 @@ class ChlorophyllComponent(_Strict):
     (Bricaud et al. 1998, 400-700 nm); b_p and bb_p of Morel & Maritorena (2001) with the
     spectral exponent of Morel et al. (2002); Fournier-Forand phase by bb_p/b_p."""
     model: Literal["chlorophyll"]
-    chl_mg_m3: Amount
+    chl_mg_m3: amount(MAX_CHL_MG_M3, "mg/m3")
 
 
 class CdomComponent(_Strict):
     """Coloured dissolved organic matter: a_g = a440 exp(-slope (lambda - 440)); no scattering."""
     model: Literal["cdom"]
-    a440: Amount
+    a440: amount(MAX_CONSTITUENT, "1/m")
     slope: Annotated[float, Field(ge=0.0, le=0.1, allow_inf_nan=False)] = 0.014
 
 
@@ -93,12 +121,12 @@ class ParticlesComponent(_Strict):
     lambda)^exponent, Fournier-Forand phase with backscatter fraction bb_ratio. concentration
     (default 1) scales a and b together and may follow a depth profile."""
     model: Literal["particles"]
-    b550: NonNegative
+    b550: Constituent
     exponent: Annotated[float, Field(ge=-1.0, le=4.0, allow_inf_nan=False)] = 1.0
     bb_ratio: BackscatterRatio = 0.0183
-    a443: NonNegative = 0.0
+    a443: Constituent = 0.0
     slope: Annotated[float, Field(ge=0.0, le=0.1, allow_inf_nan=False)] = 0.011
-    concentration: Amount = 1.0
+    concentration: amount(MAX_CONSTITUENT, "") = 1.0
 
 
 class TableComponent(_Strict):
@@ -113,11 +141,11 @@ class ConstantComponent(_Strict):
     makes it Fournier-Forand), as a layer without components has them. concentration (default
     1) scales a and b and may follow a depth profile."""
     model: Literal["constant"]
-    a: Spectral
-    b: Spectral = 0.0
+    a: spectral(Coefficient)
+    b: spectral(Coefficient) = 0.0
     phase: BasicPhase | None = None
     bb_ratio: spectral(BackscatterRatio) | None = None
-    concentration: Amount = 1.0
+    concentration: amount(MAX_CONSTITUENT, "") = 1.0
 
     @model_validator(mode="after")
     def _one_phase(self) -> "ConstantComponent":

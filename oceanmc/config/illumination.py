@@ -8,6 +8,10 @@ from pydantic import Discriminator, Field, Tag, model_validator
 
 from .base import Fraction, NonNegative, _Strict
 
+# Ed(0+) in any units, bounded so that it times any tally (tallies hold up to ~1e6 x Ed0) and
+# the batches' variances stay finite; a spectrum's Ed0 times illumination.Ed0 is held to it too
+MAX_ED0 = 1e100
+
 
 class SkyMap(_Strict):
     """A sky radiance map from a file (sky_maps.py): an equirectangular (theta_view, phi_view)
@@ -83,8 +87,7 @@ class Illumination(_Strict):
     """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
     Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
     sun_zenith_deg); or {map: FILE} (sky_maps.py)."""
-    # bounded so that Ed0 times any tally (tallies hold up to ~1e6 x Ed0) stays finite
-    Ed0: Annotated[float, Field(gt=0.0, le=1e100, allow_inf_nan=False)] = 1.0
+    Ed0: Annotated[float, Field(gt=0.0, le=MAX_ED0, allow_inf_nan=False)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
     sky: Annotated[Union[Annotated[Literal["uniform", "cardioidal", "overcast",

@@ -8,7 +8,7 @@ from typing import Annotated
 
 from pydantic import Field, field_validator, model_validator
 
-from .base import Coefficient, _Strict
+from .base import MAX_THICKNESS_M, Coefficient, _Strict
 from .components import Component
 from .phase import Isotropic, Mixture, Phase
 from .wavelengths import BackscatterRatio, spectral
@@ -17,10 +17,6 @@ from .wavelengths import BackscatterRatio, spectral
 def values(value: float | list[float]) -> list[float]:
     """A spectral key's values: a list as given, one number as a list of one."""
     return list(value) if isinstance(value, list) else [value]
-
-
-# Larger finite values only overflow optical depths (c x thickness) without meaning anything.
-MAX_THICKNESS_M = 1e6
 
 
 class Layer(_Strict):

@@ -7,9 +7,13 @@ from typing import Annotated, Union
 import numpy as np
 from pydantic import Discriminator, Field, Tag, model_validator
 
-from .base import NonNegative, _Strict
+from .base import _Strict
 
-Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+# far ultraviolet to thermal infrared: the power laws of the constituents ((550/l)^4 and the like)
+# stay finite and mean something there
+MIN_WAVELENGTH_NM, MAX_WAVELENGTH_NM = 100.0, 10_000.0
+Wavelength = Annotated[float, Field(ge=MIN_WAVELENGTH_NM, le=MAX_WAVELENGTH_NM,
+                                    allow_inf_nan=False)]
 MAX_WAVELENGTHS = 10_000
 
 
@@ -17,7 +21,7 @@ class WavelengthRange(_Strict):
     """start, start + step, ... up to stop (included when it falls on the grid), in nm."""
     start: Wavelength
     stop: Wavelength
-    step: Wavelength
+    step: Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 
     @model_validator(mode="after")
     def _ordered(self) -> "WavelengthRange":
@@ -63,7 +67,9 @@ def grid(value: Wavelengths | None) -> np.ndarray:
 
 
 # per-wavelength keys (water.layers[i].a, b, bb_ratio; components): one number or one per wavelength
-BackscatterRatio = Annotated[float, Field(ge=0.0005, le=0.45, allow_inf_nan=False)]
+# the Fournier-Forand phase functions are tabulated for these backscatter fractions
+MIN_BB_RATIO, MAX_BB_RATIO = 0.0005, 0.45
+BackscatterRatio = Annotated[float, Field(ge=MIN_BB_RATIO, le=MAX_BB_RATIO, allow_inf_nan=False)]
 
 
 def _one_or_list(value) -> str:
@@ -78,5 +84,3 @@ def spectral(number):
                                      Tag("spectral_list")]],
                      Discriminator(_one_or_list)]
 
-
-Spectral = spectral(NonNegative)

@@ -6,11 +6,16 @@ import numpy as np
 
 from .. import config as cfg
 from ..config import ConfigError
-from .tables import columns, interpolate, read_csv
+from ..config.illumination import MAX_ED0
+from ..config.wavelengths import MAX_WAVELENGTH_NM, MIN_WAVELENGTH_NM
+from .tables import interpolate, read_table
 
 # the day of year SPECTRL2's Earth-Sun distance correction uses when neither day_of_year nor
 # sun_position is given: 4 April, when the distance is 1 AU to 0.1%
 MEAN_DISTANCE_DAY = 94
+# a spectrum table's columns and their ranges (Ed0 in any units, scaled by illumination.Ed0)
+TABLE_COLUMNS = {"wavelength_nm": (MIN_WAVELENGTH_NM, MAX_WAVELENGTH_NM, "nm"),
+                 "Ed0": (0.0, MAX_ED0, ""), "diffuse_fraction": (0.0, 1.0, "")}
 
 
 def spectrl2(spectrum: cfg.Illumination, zenith_deg: float, day_of_year: int | None,
@@ -54,19 +59,19 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
                                        if light.sun_position else MEAN_DISTANCE_DAY)
         ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
     else:
-        table = read_csv(spectrum.file)
         where = "illumination.spectrum.file"
-        columns(table, ("wavelength_nm", "Ed0", "diffuse_fraction"), where, spectrum.file)
-        if np.any(table["Ed0"] < 0.0) or np.any((table["diffuse_fraction"] < 0.0)
-                                                | (table["diffuse_fraction"] > 1.0)):
-            raise ConfigError(f"{where}: {spectrum.file}: Ed0 must be >= 0 and "
-                              "diffuse_fraction within 0..1")
+        table = read_table(spectrum.file, where, TABLE_COLUMNS)
         ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where, spectrum.file)
                         for name in ("Ed0", "diffuse_fraction"))
     if np.any(ed0 <= 0.0):
         raise ConfigError(f"illumination.spectrum: Ed0 = 0 at {wl[ed0 <= 0.0][0]:g} nm; every "
                           "wavelength needs light")
-    return float(light.Ed0) * ed0, diffuse, zenith
+    ed0 = float(light.Ed0) * ed0
+    if ed0.max() > MAX_ED0:
+        raise ConfigError(f"illumination.Ed0 = {light.Ed0:g} times the spectrum's Ed0 reaches "
+                          f"{ed0.max():g} at {wl[np.argmax(ed0)]:g} nm; allowed: at most "
+                          f"{MAX_ED0:g}")
+    return ed0, diffuse, zenith
 
 
 def monochromatic_illumination(config: cfg.SceneConfig) -> cfg.Illumination:

@@ -7,8 +7,8 @@ import math
 import numpy as np
 
 from .. import config as cfg
-from ..config import ConfigError
-from .tables import columns, read_csv
+from ..config.base import MAX_THICKNESS_M
+from .tables import read_table
 
 GAUSSIAN_REACH = 8.0    # widths beyond the peak where a gaussian is its background to 1e-14
 
@@ -17,16 +17,10 @@ def nodes(profile, where: str) -> tuple[np.ndarray, np.ndarray]:
     """(depths, values) of a piecewise-linear profile (linear or table)."""
     if isinstance(profile, cfg.LinearProfile):
         return np.array(profile.depths_m), np.array(profile.values)
-    table = read_csv(profile.file)
-    columns(table, ("depth_m", "value"), f"{where}.file", profile.file)
-    depth, value = table["depth_m"], table["value"]
-    if np.any(np.diff(depth) <= 0.0) or depth[0] < 0.0:
-        raise ConfigError(f"{where}.file: {profile.file}: depth_m must be >= 0 and strictly "
-                          "increasing")
-    if np.any(value < 0.0):
-        raise ConfigError(f"{where}.file: {profile.file}: value = {value[value < 0][0]:g} at "
-                          f"depth {depth[value < 0][0]:g} m; a profile must be >= 0")
-    return depth, value
+    limit, unit = profile._limit    # the range of the key it profiles (config/components.py)
+    table = read_table(profile.file, f"{where}.file", {"depth_m": (0.0, MAX_THICKNESS_M, "m"),
+                                                       "value": (0.0, limit, unit)}, rows=2)
+    return table["depth_m"], table["value"]
 
 
 def value_at(profile, z: np.ndarray, where: str) -> np.ndarray:

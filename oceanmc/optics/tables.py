@@ -23,6 +23,10 @@ def read_csv(path: str) -> dict[str, np.ndarray]:
     if len(rows) < 2:
         raise ConfigError(f"{path}: needs a header line of column names and at least one row")
     names = [n.strip() for n in rows[0].split(",")]
+    twice = [n for k, n in enumerate(names) if n in names[:k]]
+    if twice:
+        raise ConfigError(f"{path}: column {twice[0]!r} appears twice in the header; allowed: "
+                          "each column once")
     try:
         data = np.array([[float(x) for x in row.split(",")] for row in rows[1:]])
     except ValueError:
@@ -39,13 +43,40 @@ def packaged(name: str) -> dict[str, np.ndarray]:
     return read_csv(str(resources.files("oceanmc") / "data" / name))
 
 
-def columns(table: dict[str, np.ndarray], needed: tuple[str, ...], where: str,
-            path: str) -> None:
-    """One line naming the missing columns of a user's table."""
-    missing = [c for c in needed if c not in table]
+def read_table(path: str, where: str, ranges: dict[str, tuple[float, float, str]],
+               rows: int = 1) -> dict[str, np.ndarray]:
+    """A user's CSV with the columns named in `ranges` ({name: (lowest, highest, unit)}; the
+    first is the one interpolated along and must increase strictly) and at least `rows` rows;
+    every value finite and within its column's range, so that nothing computed from them
+    overflows. Every problem is one line naming the key, the file, the value and what is
+    allowed."""
+    try:
+        table = read_csv(path)
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    missing = [c for c in ranges if c not in table]
     if missing:
         raise ConfigError(f"{where}: {path} lacks the column(s) {', '.join(missing)}; needed: "
-                          f"{', '.join(needed)} (found: {', '.join(table)})")
+                          f"{', '.join(ranges)} (found: {', '.join(table)})")
+    axis = next(iter(ranges))
+    nodes = table[axis]
+    if len(nodes) < rows:
+        raise ConfigError(f"{where}: {path} has {len(nodes)} row of {axis}; allowed: at least "
+                          f"{rows}")
+    for name, (low, high, unit) in ranges.items():
+        values = table[name]
+        outside = ~(np.isfinite(values) & (values >= low) & (values <= high))
+        if outside.any():
+            k = int(np.argmax(outside))
+            at = f"row {k + 1}" if name == axis else f"{axis} = {nodes[k]:g}"
+            raise ConfigError(f"{where}: {path}: {name} = {values[k]:g} at {at}; allowed: "
+                              f"{low:g} .. {high:g}{' ' + unit if unit else ''}")
+    falling = np.diff(nodes) <= 0.0
+    if falling.any():
+        k = int(np.argmax(falling))
+        raise ConfigError(f"{where}: {path}: {axis} = {nodes[k + 1]:g} follows {nodes[k]:g}; "
+                          f"allowed: strictly increasing")
+    return table
 
 
 def interpolate(wavelengths: np.ndarray, nodes: np.ndarray, values: np.ndarray, where: str,

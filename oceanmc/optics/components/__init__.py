@@ -15,6 +15,7 @@ from importlib import import_module
 import numpy as np
 
 from ... import registry
+from ...config.wavelengths import MAX_BB_RATIO, MIN_BB_RATIO
 
 
 @dataclass(frozen=True)
@@ -41,7 +42,7 @@ def fournier_forand_by_ratio(ratios: np.ndarray) -> tuple[tuple, np.ndarray]:
     wavelength: one phase per distinct ratio (rounded to 4 significant digits, so that a smooth
     spectrum or a depth profile does not tabulate a new phase function at every wavelength and
     sublayer; the bb reported is b times the rounded ratio, what the kernel samples)."""
-    clipped = np.clip(ratios, 0.0005, 0.45)
+    clipped = np.clip(ratios, MIN_BB_RATIO, MAX_BB_RATIO)
     scale = 10.0 ** (3 - np.floor(np.log10(clipped)))
     rounded = np.round(clipped * scale) / scale
     distinct, column = np.unique(rounded, return_inverse=True)
