@@ -71,19 +71,21 @@ class StopRequest:
     """The first SIGINT or SIGTERM asks the run to stop (the kernel returns within a fraction of
     a second, simulation.CALL_SECONDS) and write what it has; the default handlers come back, so
     a second signal ends the process at once (the atomic write means no results file is ever
-    left half written)."""
+    left half written). Installed whatever the signals' handlers were: a command started in the
+    background by a script inherits SIGINT as ignored, and `kill -INT` must still stop it."""
 
-    def __init__(self) -> None:
+    def __init__(self, doing: str = "stopping and writing the photons done so far") -> None:
         self.requested = False
         self.signal_name = ""
+        self.doing = doing
 
     def __call__(self, signum, frame) -> None:
         self.requested = True
         self.signal_name = signal.Signals(signum).name
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        print(f"\noceanmc: {self.signal_name}: stopping and writing the photons done so far; "
-              "press Ctrl-C again to quit at once", file=sys.stderr, flush=True)
+        print(f"\noceanmc: {self.signal_name}: {self.doing}; press Ctrl-C again to quit at "
+              "once", file=sys.stderr, flush=True)
 
     def install(self) -> None:
         signal.signal(signal.SIGINT, self)
@@ -266,7 +268,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from .sweeps import SweepError, sweep
+    from .run.compiling import CompileInterrupted
+    from .sweeps import OutputExists, SweepError, sweep
 
     source = Path(args.sweep)
     out = Path(args.output) if args.output else Path("results") / f"{source.stem}.nc"
@@ -274,24 +277,40 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise UsageError(f"{source}: no such file")
     if out.suffix != ".nc":
         raise UsageError(f"-o {out}: a sweep writes a NetCDF file; name it *.nc")
-    _check_writable(out, overwrite=True)
-    if out.exists() and not args.overwrite and not _is_sweep_dataset(out):
-        raise UsageError(f"{out} exists and is not an oceanmc sweep dataset; pass --overwrite "
-                         "to replace it")
+    _check_writable(out, overwrite=True)   # what the sweep may replace: sweep() judges it
+    # the same signals, the same way, as `oceanmc run`: SIGTERM (a batch scheduler's) and a
+    # SIGINT inherited as ignored (a background job of a script) stop it as Ctrl-C does
+    stop = StopRequest("stopping: cancelling the points not finished, then writing the dataset "
+                       "with those done and closing the workers")
+    stop.install()
     try:
         lut = sweep(source, out, workers=args.workers, scheduler=args.scheduler,
                     threads=args.threads, batch_groups=args.batch_groups,
                     workers_write=True if args.workers_write else None, progress=not args.quiet,
                     log=lambda text: print(f"oceanmc: sweep: {text}", file=sys.stderr,
-                                           flush=True))
+                                           flush=True),
+                    overwrite=args.overwrite, should_stop=lambda: stop.requested)
+    except OutputExists as exc:
+        raise UsageError(str(exc)) from None
     except SweepError as exc:
         print(f"oceanmc: config error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except CompileInterrupted:
+        # the compilation goes on in its own thread inside LLVM; leave at once (as cmd_run)
+        print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; no "
+              "point ran and no dataset was written", file=sys.stderr, flush=True)
+        sys.stdout.flush()
+        os._exit(130)
+    except KeyboardInterrupt:   # a KeyboardInterrupt raised by other means than the signal
         print(f"oceanmc: sweep interrupted: wrote {out} with the points done so far (status "
               f"'pending' for the others); the same command finishes it", file=sys.stderr)
         return 130
     a = lut.attrs
+    if stop.requested:
+        print(f"oceanmc: sweep interrupted: wrote {out} with the points done so far "
+              f"({a['points_done']} of {a['points']}; status 'pending' for the others; stopped "
+              f"by {stop.signal_name}); the same command finishes it", file=sys.stderr)
+        return 130
     print(f"{a['points_done']} of {a['points']} points done, {a['points_failed']} failed; "
           f"wrote {out} (finished points are kept in {out.with_suffix('.points')}/)")
     failed = lut["status"].values == "failed"
@@ -300,15 +319,6 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                                                                         .split(","), index))
         print(f"  failed ({where}): {lut['error'].values[index]}")
     return 1 if a["points_failed"] else 0
-
-
-def _is_sweep_dataset(path: Path) -> bool:
-    import h5py
-    try:
-        with h5py.File(path, "r") as f:
-            return f.attrs.get("title") in ("oceanmc sweep", b"oceanmc sweep")
-    except OSError:
-        return False
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -410,7 +420,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="with --scheduler: the workers see the output folder (a shared file "
                             "system) and write each point's file themselves")
     sweep.add_argument("--overwrite", action="store_true",
-                       help="replace an output file that is not an oceanmc sweep dataset")
+                       help="replace an output file that is not this sweep's dataset (another "
+                            "sweep's, or not a sweep dataset); a rerun of the same sweep, or "
+                            "one with values added to its axes, needs no --overwrite")
     sweep.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     sweep.set_defaults(func=cmd_sweep)
 

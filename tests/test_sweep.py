@@ -259,3 +259,118 @@ def test_ctrl_c_leaves_a_valid_partial_dataset_and_a_rerun_finishes_it(tmp_path)
     final = xr.open_dataset(tmp_path / "lut.nc", engine="h5netcdf").load()
     assert final.attrs["partial"] == 0 and (final["status"].values == "done").all()
     assert assert_points_match_single_runs(final, path) == 6
+
+
+# --- a dataset of another sweep is never replaced without --overwrite ---------------------------
+
+def test_another_sweeps_dataset_is_refused_without_overwrite_and_a_rerun_is_not(tmp_path):
+    """lut.nc of sweep A: sweep B (other axis values, or another base scene) to the same lut.nc
+    is refused in one line, exit 2, before anything runs, the dataset and the points folder
+    untouched; A again, or A with a value added to an axis, replaces it (the resume feature);
+    --overwrite replaces another sweep's dataset."""
+    from distributed import Client, LocalCluster
+
+    out = tmp_path / "lut.nc"
+    a = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1],
+                              "bottom.reflectance": [0.1, 0.2]})
+    a = a.rename(tmp_path / "a.yaml")
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        first = oceanmc.sweep(a, out, client=client, threads=1)
+        assert first.attrs["points_done"] == 4
+        before = out.read_bytes()
+        folder = sorted(p.name for p in (tmp_path / "lut.points").iterdir())
+
+        def refused(spec, *words):
+            done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", spec, "-o",
+                                   "lut.nc", "-q"], cwd=tmp_path, env=ENV, capture_output=True,
+                                  text=True, timeout=300)
+            assert done.returncode == 2, done.stderr
+            assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr, done.stderr
+            assert done.stderr.startswith("oceanmc: error: lut.nc holds the dataset of another "
+                                          "sweep ("), done.stderr
+            assert "--overwrite" in done.stderr
+            for word in words:
+                assert word in done.stderr, done.stderr
+            assert out.read_bytes() == before
+            assert sorted(p.name for p in (tmp_path / "lut.points").iterdir()) == folder
+            return done.stderr
+
+        # other values on the same axes (a.yaml's 0.05 gone), then another base scene
+        b = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.3],
+                                  "bottom.reflectance": [0.1, 0.2]}).rename(tmp_path / "b.yaml")
+        refused(b, "its point (water.layers[0].a = 0.05, bottom.reflectance = 0.1) is not one "
+                   "of this sweep's, and 1 more of its 4 points")
+        other_base = copy.deepcopy(TINY)
+        other_base["seed"] = 8
+        c = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1],
+                                  "bottom.reflectance": [0.1, 0.2]}, base=other_base)
+        refused(c.rename(tmp_path / "c.yaml"), "its base scene differs: seed differs")
+        with pytest.raises(oceanmc.sweeps.OutputExists, match="another sweep"):
+            oceanmc.sweep(b, out, client=client, threads=1)     # the Python call refuses too
+        assert out.read_bytes() == before
+
+        # the same sweep with its axes in another order and a value added: not another sweep
+        spec = yaml.safe_load(a.read_text())
+        spec["axes"] = {"bottom.reflectance": [0.1, 0.2],
+                        "water.layers[0].a": [0.05, 0.1, 0.2]}
+        a.write_text(yaml.safe_dump(spec, sort_keys=False))
+        said = []
+        grown = oceanmc.sweep(a, out, client=client, threads=1, log=said.append)
+        assert "4 finished earlier, 2 to run" in said[0] and grown.attrs["points_done"] == 6
+
+        replaced = oceanmc.sweep(b, out, client=client, threads=1, overwrite=True)
+        assert list(replaced["water.layers[0].a"].values) == [0.1, 0.3]
+    stored = xr.open_dataset(out, engine="h5netcdf").load()
+    assert list(stored["water.layers[0].a"].values) == [0.1, 0.3]
+    # a file that is no sweep dataset: refused as well
+    (tmp_path / "notes.nc").write_text("not a dataset")
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", "b.yaml", "-o", "notes.nc"],
+                          cwd=tmp_path, env=ENV, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert "notes.nc exists and is not an oceanmc sweep dataset" in done.stderr
+
+
+# --- SIGTERM, and SIGINT inherited as ignored (a background job of a script) ---------------------
+
+def _ignore_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize("signal_number, preexec", [(signal.SIGTERM, None),
+                                                    (signal.SIGINT, _ignore_sigint)],
+                         ids=["sigterm", "sigint_inherited_as_ignored"])
+def test_sigterm_or_ignored_sigint_stops_a_sweep_with_a_valid_partial_dataset(
+        tmp_path, signal_number, preexec):
+    """What a batch scheduler sends (SIGTERM), and kill -INT to a sweep a script started in the
+    background (SIGINT ignored from its start), stop it as Ctrl-C does: the points not finished
+    are cancelled, lut.nc is written with those done (partial, the rest pending), the cluster is
+    closed (no leaked semaphores), exit 130, within seconds."""
+    scene = copy.deepcopy(TINY)
+    scene["photons"] = 200000      # a point in hand when the signal comes
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1, 0.2, 0.3, 0.4, 0.5]},
+                      base=scene)
+    points = tmp_path / "lut.points"
+    run = oceanmc_cli("sweep", path, "-o", "lut.nc", "--workers", "1", "-q", cwd=tmp_path,
+                      preexec_fn=preexec)
+    deadline = time.monotonic() + 120
+    while not (points.is_dir() and any(points.glob("*.h5"))):
+        assert run.poll() is None, run.communicate()
+        assert time.monotonic() < deadline, "no point finished"
+        time.sleep(0.05)
+    sent = time.monotonic()
+    run.send_signal(signal_number)
+    out, err = run.communicate(timeout=120)
+    latency = time.monotonic() - sent
+    print(f"exit {latency:.1f} s after {signal.Signals(signal_number).name}")
+    assert run.returncode == 130, err
+    assert latency < 30.0, latency
+    assert "Traceback" not in err and "leaked" not in err, err
+    assert f"stopped by {signal.Signals(signal_number).name}" in err
+    assert "sweep interrupted: wrote lut.nc" in err
+    partial = xr.open_dataset(tmp_path / "lut.nc", engine="h5netcdf").load()
+    done = int((partial["status"].values == "done").sum())
+    assert partial.attrs["partial"] == 1 and 1 <= done < 6
+    assert partial.attrs["points_pending"] == 6 - done
+    assert assert_points_match_single_runs(partial, path, only_done=True) == done
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lut.nc", "lut.points", "sweep.yaml"]

@@ -16,11 +16,12 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .axes import SweepError, SweepSpec, load_sweep, set_key_path
-from .dataset import PointStore, Summary, assemble, write_dataset
+from .dataset import (OutputExists, PointStore, Summary, assemble, check_replaceable,
+                      write_dataset)
 from .points import Point, build_points, check_scenes
 
-__all__ = ["sweep", "prepare", "SweepError", "SweepSpec", "load_sweep", "set_key_path",
-           "points_folder"]
+__all__ = ["sweep", "prepare", "SweepError", "OutputExists", "SweepSpec", "load_sweep",
+           "set_key_path", "points_folder"]
 
 
 def points_folder(output: Path) -> Path:
@@ -52,17 +53,22 @@ class Plan:
         return assemble(self.spec, self.points, self.summaries, self.errors)
 
 
-def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | None = None
-            ) -> Plan:
+def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | None = None,
+            *, replacing: Path | None = None,
+            should_stop: Callable[[], bool] | None = None) -> Plan:
     """Reads and validates the sweep (every point's scene, tables included: SweepError naming
-    the point), and finds the points a previous run has finished."""
+    the point), and finds the points a previous run has finished. replacing: the dataset this
+    sweep will write, which must not hold anything it would lose (OutputExists, before the
+    kernel is compiled). should_stop: checked while the kernel compiles (CompileInterrupted)."""
     from ..run.compiling import ready
 
     spec = load_sweep(source)
     if batch_groups is not None:
         spec = SweepSpec(spec.base, spec.base_dir, spec.settings, spec.axes, batch_groups)
     points = build_points(spec)
-    ready()   # compiles here, once, into the disk cache that local workers load from
+    if replacing is not None:
+        check_replaceable(replacing, store_folder, spec)
+    ready(should_stop)   # compiles here, once, into the disk cache that local workers load from
     check_scenes(points)
     store = PointStore(store_folder)
     plan = Plan(spec, points, store)
@@ -74,10 +80,11 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
 
 
 def run(plan: Plan, client, threads: int | None = None, progress: bool = False,
-        workers_write: bool = False) -> None:
+        workers_write: bool = False, should_stop: Callable[[], bool] | None = None) -> None:
     """Runs the points not yet done on the client's cluster; each finished point is stored as it
-    arrives (a KeyboardInterrupt leaves the plan with what is done). workers_write: the workers
-    see the output folder and write the points' results files themselves."""
+    arrives (a KeyboardInterrupt, or should_stop() turning true, cancels the rest and leaves
+    the plan with what is done). workers_write: the workers see the output folder and write the
+    points' results files themselves."""
     from .execute import run_points
 
     def on_done(point: Point, summary: Summary | None, error: str | None) -> None:
@@ -89,14 +96,15 @@ def run(plan: Plan, client, threads: int | None = None, progress: bool = False,
     todo = plan.todo
     if todo:
         run_points(client, plan.store, todo, plan.spec.batch_groups, threads, on_done, progress,
-                   len(plan.points), len(plan.points) - len(todo), workers_write)
+                   len(plan.points), len(plan.points) - len(todo), workers_write, should_stop)
 
 
 def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None, *,
           workers: int | None = None, scheduler: str | None = None, client=None,
           threads: int | None = None, batch_groups: int | None = None,
           workers_write: bool | None = None, progress: bool = False,
-          log: Callable[[str], None] | None = None):
+          log: Callable[[str], None] | None = None, overwrite: bool = False,
+          should_stop: Callable[[], bool] | None = None):
     """Runs a sweep and returns its xarray Dataset (written to `output`, a .nc file, if given).
 
     source: a sweep YAML file or a mapping {base: scene file | scene mapping | SceneConfig,
@@ -108,13 +116,19 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     a rerun skips them. workers_write: the workers write the points' files there themselves
     (they must see that folder: a shared file system; default: only on the local cluster
     started here), else they send each Result back to be written here. A KeyboardInterrupt
-    writes the points done so far (status `pending` for the rest) and is raised again.
-    log(text) receives a line on what is about to run."""
+    writes the points done so far (status `pending` for the rest) and is raised again;
+    should_stop() turning true does the same and returns that partial dataset (attribute
+    partial = 1): a caller's signal handler sets it (the command's SIGINT and SIGTERM).
+    An existing `output` is replaced only if it is this sweep's dataset or that of a sweep
+    whose every point this one has (a rerun, or values added to an axis), else OutputExists
+    (before anything runs), unless overwrite. log(text) receives a line on what is about to
+    run."""
     import os
 
     with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:
         folder = points_folder(Path(output)) if output is not None else Path(scratch)
-        plan = prepare(source, folder, batch_groups)
+        plan = prepare(source, folder, batch_groups, should_stop=should_stop,
+                       replacing=None if output is None or overwrite else Path(output))
         local = client is None and scheduler is None
         if local:
             workers = workers or os.cpu_count() or 1
@@ -134,13 +148,14 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
                 write_dataset(dataset, Path(output))
             return dataset
 
-        if not todo:
+        if not todo or (should_stop is not None and should_stop()):
             return finish()
         from .execute import dask_client
         with dask_client(workers, scheduler, client) as dask:
             try:
                 run(plan, dask, threads, progress,
-                    workers_write=local if workers_write is None else workers_write)
+                    workers_write=local if workers_write is None else workers_write,
+                    should_stop=should_stop)
             finally:   # also on Ctrl-C: the points done so far, before the cluster closes
                 dataset = finish()
     return dataset

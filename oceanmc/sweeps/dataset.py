@@ -17,11 +17,18 @@ import yaml
 
 from .. import __version__
 from ..run.hdf5 import COORD_UNITS, load_result, place_atomically
-from ..run.results import Result, merge_results
-from .axes import SweepSpec, coordinate
+from ..run.results import Result, merge_results, scene_difference
+from .axes import SweepError, SweepSpec, coordinate, label, load_sweep
 from .points import Point
 
 DONE, FAILED, PENDING = "done", "failed", "pending"
+TITLE = "oceanmc sweep"
+
+
+class OutputExists(Exception):
+    """The output path holds something this sweep must not replace without overwrite=True (a
+    file that is not a sweep dataset, or the dataset of another sweep); the message says which
+    and how to go on."""
 
 
 @dataclass
@@ -153,7 +160,7 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     data["wall_time_s"] = (dims, wall, {"units": "s", "description": "run time of the point"})
     counts = {s: int((status == s).sum()) for s in (DONE, FAILED, PENDING)}
     attrs = {
-        "title": "oceanmc sweep",
+        "title": TITLE,
         "oceanmc_version": __version__,
         "base_scene_yaml": yaml.safe_dump(spec.base, sort_keys=False),
         "sweep_yaml": spec.to_yaml(),
@@ -176,3 +183,62 @@ def write_dataset(dataset, path: Path) -> Path:
     """NetCDF4 via h5netcdf, atomically (a temporary file renamed into place), so a crash or a
     second Ctrl-C never leaves half a dataset."""
     return place_atomically(path, lambda tmp: dataset.to_netcdf(tmp, engine="h5netcdf"))
+
+
+def check_replaceable(path: Path, folder: Path, spec: SweepSpec) -> None:
+    """Raises OutputExists unless writing this sweep's dataset at `path` loses nothing: there is
+    no file there, or it is the dataset of this sweep or of one whose every point this sweep
+    also has (a rerun, or a rerun with values added to an axis: the resume feature). Points
+    are compared as their scenes (the base scene with the point's keys set), rebuilt from the
+    dataset's base_scene_yaml and sweep_yaml, so the order of the axes does not matter. The
+    points folder is never refused: its files are named by their scenes' hashes, so another
+    sweep's points there are kept, never replaced."""
+    how = "pass --overwrite to replace it (overwrite=True), or write this sweep elsewhere " \
+        "with -o"
+    if folder.exists() and not folder.is_dir():
+        raise OutputExists(f"{folder} exists and is not a folder: a sweep keeps its finished "
+                           f"points there; move it away or write the sweep elsewhere with -o")
+    if not path.exists():
+        return
+    if path.is_dir():
+        raise OutputExists(f"{path} is a folder, not a dataset; write the sweep elsewhere with -o")
+    import h5py
+    try:
+        with h5py.File(path, "r") as f:
+            attrs = {key: f.attrs.get(key) for key in ("title", "base_scene_yaml", "sweep_yaml")}
+    except OSError:
+        raise OutputExists(f"{path} exists and is not an oceanmc sweep dataset (not HDF5/NetCDF4)"
+                           f"; {how}") from None
+    text = {key: value.decode() if isinstance(value, bytes) else value
+            for key, value in attrs.items()}
+    if text["title"] != TITLE:
+        raise OutputExists(f"{path} exists and is not an oceanmc sweep dataset; {how}")
+    try:
+        stored = yaml.safe_load(text["sweep_yaml"])
+        base = yaml.safe_load(text["base_scene_yaml"])
+        old = load_sweep({"base": base, "set": stored.get("set"), "axes": stored.get("axes")})
+        old_scenes = {_canonical(old.scene_at(a)): a for _, a in old.points()}
+    except (SweepError, yaml.YAMLError, AttributeError, TypeError):
+        raise OutputExists(f"{path} is an oceanmc sweep dataset whose sweep cannot be read back "
+                           f"(attributes base_scene_yaml, sweep_yaml); {how}") from None
+    new_scenes = {_canonical(spec.scene_at(a)) for _, a in spec.points()}
+    missing = [a for scene, a in old_scenes.items() if scene not in new_scenes]
+    if not missing:
+        return
+    if len(missing) == len(old_scenes) and base != spec.base:
+        differs = scene_difference(text["base_scene_yaml"], yaml.safe_dump(spec.base))
+        why = f"its base scene differs: {differs or 'the scene differs'}"
+    elif len(missing) == len(old_scenes) and old.settings != spec.settings:
+        keys = sorted(set(old.settings) ^ set(spec.settings)) or \
+            sorted(k for k in old.settings if old.settings[k] != spec.settings[k])
+        why = f"its `set` differs: {keys[0]}"
+    else:
+        more = f", and {len(missing) - 1} more of its {len(old_scenes)} points" \
+            if len(missing) > 1 else ""
+        why = f"its point ({label(missing[0])}) is not one of this sweep's{more}"
+    raise OutputExists(f"{path} holds the dataset of another sweep ({why}); {how}")
+
+
+def _canonical(scene: dict) -> str:
+    """A point's scene as text that equal scenes share (keys sorted)."""
+    return yaml.safe_dump(scene, sort_keys=True)

@@ -11,7 +11,8 @@ points are checked, which fills the on-disk cache the workers of a local cluster
 Dask reschedules the tasks of a worker that dies (a lost worker's points run elsewhere; after
 `distributed.scheduler.allowed-failures` + 1 deaths with the same task, 4 by default, that
 point is recorded as failed). A point whose task raises is recorded with its error and the others go
-on. Ctrl-C (KeyboardInterrupt) cancels what is left; the caller then writes what is done.
+on. Ctrl-C (KeyboardInterrupt), or a stop asked by the caller's should_stop() (the command's
+SIGINT and SIGTERM handler), cancels what is left; the caller then writes what is done.
 """
 from __future__ import annotations
 
@@ -34,8 +35,21 @@ def load_kernel() -> float:
     that the first point's run time is its own); returns the seconds it took."""
     from ..run.compiling import ready
     t0 = time.perf_counter()
+    _no_process_lock_for_tqdm()
     ready()
     return time.perf_counter() - t0
+
+
+def _no_process_lock_for_tqdm() -> None:
+    """tqdm's first bar (simulate makes one, hidden, in a worker too) creates a multiprocessing
+    lock, a named semaphore that a worker killed mid-point (a cluster closed on Ctrl-C or
+    SIGTERM) leaves behind: Python then warns of leaked semaphores at exit. A worker's bars are
+    never shown, so a thread lock serves."""
+    import threading
+
+    from tqdm import tqdm as bar
+    if not isinstance(getattr(bar, "_lock", None), type(threading.RLock())):
+        bar.set_lock(threading.RLock())
 
 
 def run_part(scene_yaml: str, first_batch: int, threads: int | None, save_to: str | None):
@@ -48,6 +62,7 @@ def run_part(scene_yaml: str, first_batch: int, threads: int | None, save_to: st
 
     from ..config import load_config
     from ..run.simulation import simulate
+    _no_process_lock_for_tqdm()   # a worker started after the others (one that died) too
     try:
         config = load_config(yaml.safe_load(scene_yaml))
         result = simulate(config, threads=threads, first_batch=first_batch)
@@ -83,12 +98,20 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, client
 
 def run_points(client, store: PointStore, todo: list[Point], groups: int, threads: int | None,
                on_done: Callable[[Point, Summary | None, str | None], None],
-               progress: bool, total: int, skipped: int, workers_write: bool) -> None:
+               progress: bool, total: int, skipped: int, workers_write: bool,
+               should_stop: Callable[[], bool] | None = None) -> None:
     """Submits every point (or its unfinished batch groups) and calls on_done(point, summary,
     None) or on_done(point, None, error) as each point ends, whatever the order. workers_write:
-    the workers see the store's folder (a local cluster) and write the results files."""
+    the workers see the store's folder (a local cluster) and write the results files.
+    should_stop() is asked every POLL_S: when it says so, the points not finished are
+    cancelled and this returns (as on a KeyboardInterrupt, which is raised again)."""
     from distributed.client import FutureCancelledError
 
+    def stopping() -> bool:
+        return should_stop is not None and should_stop()
+
+    if stopping():
+        return
     client.run(load_kernel)
     task_of = {}       # future -> (point, batch range)
     remaining = {}     # point key -> batch ranges still running
@@ -116,7 +139,7 @@ def run_points(client, store: PointStore, todo: list[Point], groups: int, thread
                 on_done(point, store.merge_parts(point, ranges_of[point.key]), None)
                 bar.update(1)
         try:
-            while pending:
+            while pending and not stopping():
                 done = {future for future in pending if future.done()}
                 if not done:
                     time.sleep(POLL_S)   # short sleeps: Ctrl-C is seen at once
