@@ -153,6 +153,25 @@ def test_wavelengths_and_profile_table_amounts_beyond_their_range_are_refused(tm
         "allowed: 0 .. 100 mg/m3")
 
 
+@pytest.mark.parametrize("key, value, words", [
+    ("surface_pressure_pa", 1e30, ["surface_pressure_pa = 1e+30", "110000"]),
+    ("precipitable_water_cm", 1e30, ["precipitable_water_cm = 1e+30", "equal to 10"]),
+    ("ozone_atm_cm", 50, ["ozone_atm_cm = 50", "equal to 1"]),
+    ("aerosol_turbidity_500nm", 1e30, ["aerosol_turbidity_500nm = 1e+30"]),
+    ("alpha", 1e30, ["alpha = 1e+30", "equal to 4"]),
+    ("wavelength_variation_factor", 1e30, ["wavelength_variation_factor = 1e+30"]),
+])
+def test_spectrl2_inputs_out_of_range_are_refused(key, value, words):
+    refused(scene(illumination={"spectrum": {"model": "spectrl2", key: value}}),
+            "illumination.spectrum.", *words)
+
+
+def test_sun_position_beyond_the_solar_position_algorithm_is_refused():
+    refused(scene(illumination={"sun_position": {"time": "9999-06-21T12:00:00Z",
+                                                 "latitude_deg": 0.0, "longitude_deg": 0.0}}),
+            "illumination.sun_position.time", "year 9999; allowed: up to 6000")
+
+
 def test_one_row_profile_table_is_refused(tmp_path, capsys):
     (tmp_path / "t.csv").write_text(PROFILE + "0,1\n")
     refused_run(tmp_path, capsys, scene([{"model": "chlorophyll", "chl_mg_m3": {

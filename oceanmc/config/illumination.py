@@ -4,9 +4,9 @@ from __future__ import annotations
 import datetime as dt
 from typing import Annotated, Literal, Union
 
-from pydantic import Discriminator, Field, Tag, model_validator
+from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 
-from .base import Fraction, NonNegative, _Strict
+from .base import Fraction, _Strict
 
 # Ed(0+) in any units, bounded so that it times any tally (tallies hold up to ~1e6 x Ed0) and
 # the batches' variances stay finite; a spectrum's Ed0 times illumination.Ed0 is held to it too
@@ -39,10 +39,20 @@ class SkyMap(_Strict):
         return self
 
 
+SPA_LAST_YEAR = 6000
+
+
+def _spa_years(time: dt.datetime) -> dt.datetime:
+    if time.year > SPA_LAST_YEAR:     # datetime's own years start at 1, within SPA's -2000
+        raise ValueError(f"year {time.year}; allowed: up to {SPA_LAST_YEAR} (the years the solar "
+                         "position algorithm is valid for, -2000 .. 6000)")
+    return time
+
+
 class SunPosition(_Strict):
     """The sun's zenith angle from the time (ISO 8601; without a zone it is UTC) and the place
     (degrees north, degrees east), by pvlib's solar position (NREL SPA, Reda & Andreas 2004)."""
-    time: dt.datetime
+    time: Annotated[dt.datetime, AfterValidator(_spa_years)]
     latitude_deg: Annotated[float, Field(ge=-90.0, le=90.0, allow_inf_nan=False)]
     longitude_deg: Annotated[float, Field(ge=-180.0, le=180.0, allow_inf_nan=False)]
 
@@ -59,13 +69,19 @@ class Spectrl2Spectrum(_Strict):
     its diffuse share. The atmosphere's parameters are SPECTRL2's (defaults: pvlib's and Bird &
     Riordan's)."""
     model: Literal["spectrl2"]
-    surface_pressure_pa: Annotated[float, Field(gt=0.0, allow_inf_nan=False)] = 101325.0
-    precipitable_water_cm: NonNegative = 1.42
-    ozone_atm_cm: NonNegative = 0.344
-    aerosol_turbidity_500nm: NonNegative = 0.1
+    # generous bounds of Earth's clear atmospheres: the pressure at any lake or sea surface
+    # (the highest lakes, ~6000 m, ~47 kPa; sea-level records 87-108.5 kPa); precipitable water
+    # (records ~7.5 cm); ozone (0.1-0.6 atm-cm observed); aerosol optical depth at 500 nm (dense
+    # smoke or dust ~5); the Angstrom exponent (0-2.5 observed); Bird & Riordan's omega' (0.095)
+    surface_pressure_pa: Annotated[float, Field(ge=40_000.0, le=110_000.0,
+                                                allow_inf_nan=False)] = 101325.0
+    precipitable_water_cm: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 1.42
+    ozone_atm_cm: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.344
+    aerosol_turbidity_500nm: Annotated[float, Field(ge=0.0, le=10.0,
+                                                    allow_inf_nan=False)] = 0.1
     scattering_albedo_400nm: Fraction = 0.945
-    alpha: NonNegative = 1.14
-    wavelength_variation_factor: NonNegative = 0.095
+    alpha: Annotated[float, Field(ge=0.0, le=4.0, allow_inf_nan=False)] = 1.14
+    wavelength_variation_factor: Fraction = 0.095
     aerosol_asymmetry_factor: Annotated[float, Field(gt=-1.0, lt=1.0,
                                                      allow_inf_nan=False)] = 0.65
     # else sun_position's day, else 4 April (Earth-Sun distance 1 AU)
