@@ -172,6 +172,20 @@ def test_sun_position_beyond_the_solar_position_algorithm_is_refused():
             "illumination.sun_position.time", "year 9999; allowed: up to 6000")
 
 
+@pytest.mark.parametrize("component, key, count", [
+    ({"model": "constant", "a": [0.1]}, "a", 1),
+    ({"model": "constant", "a": [0.1, 0.2]}, "a", 2),
+    ({"model": "constant", "a": 0.1, "b": [0.1, 0.2, 0.3, 0.4]}, "b", 4),
+    ({"model": "constant", "a": 0.1, "b": 0.1, "bb_ratio": [0.01, 0.02]}, "bb_ratio", 2),
+])
+def test_component_lists_need_one_value_per_wavelength(component, key, count):
+    refused(scene([component]), f"water.layers[0].components[1].{key} has {count} values",
+            "allowed: one number or one value per wavelength (3 in wavelengths_nm)")
+    # a list with one value per wavelength is what is allowed
+    component = dict(component, **{key: [0.01, 0.02, 0.03]})
+    assert oceanmc.load_config(scene([component])).water.layers[0].components[1]
+
+
 def test_one_row_profile_table_is_refused(tmp_path, capsys):
     (tmp_path / "t.csv").write_text(PROFILE + "0,1\n")
     refused_run(tmp_path, capsys, scene([{"model": "chlorophyll", "chl_mg_m3": {

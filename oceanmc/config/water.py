@@ -86,23 +86,26 @@ class Water(_Strict):
         return self
 
     def check_wavelength_count(self, n_wavelengths: int, spectral: bool) -> None:
-        """Every list has one value per wavelength; lists need `wavelengths_nm`."""
+        """Every list (a layer's a, b, bb_ratio; a component's) has one value per wavelength;
+        lists need `wavelengths_nm`."""
         for i, layer in enumerate(self.layers):
             if layer.components is not None and not spectral:
                 raise ValueError(f"water.layers[{i}].components: constituents need "
                                  "wavelengths_nm (a list in nm, or {start, stop, step})")
-            for key in ("a", "b", "bb_ratio"):
-                value = getattr(layer, key)
+            lists = [(f"water.layers[{i}].{key}", getattr(layer, key))
+                     for key in ("a", "b", "bb_ratio")]
+            lists += [(f"water.layers[{i}].components[{k}].{key}", value)
+                      for k, component in enumerate(layer.components or ())
+                      for key, value in component if isinstance(value, list)]
+            for key, value in lists:
                 if not isinstance(value, list):
                     continue
                 if not spectral:
-                    raise ValueError(f"water.layers[{i}].{key} is a list ({len(value)} values) "
-                                     "but wavelengths_nm is not given; give wavelengths_nm or "
-                                     "one number")
+                    raise ValueError(f"{key} is a list ({len(value)} values) but wavelengths_nm "
+                                     "is not given; give wavelengths_nm or one number")
                 if len(value) != n_wavelengths:
-                    raise ValueError(f"water.layers[{i}].{key} has {len(value)} values; allowed: "
-                                     f"one number or one value per wavelength "
-                                     f"({n_wavelengths} in wavelengths_nm)")
+                    raise ValueError(f"{key} has {len(value)} values; allowed: one number or one "
+                                     f"value per wavelength ({n_wavelengths} in wavelengths_nm)")
 
     @property
     def depth_m(self) -> float:
