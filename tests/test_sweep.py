@@ -89,6 +89,35 @@ def test_key_paths_reach_nested_lists_and_create_missing_mappings():
         set_key_path(scene, "water..a", 0.1)
 
 
+def test_unknown_key_in_an_axis_is_named_with_a_suggestion(tmp_path):
+    """A misspelt key on the way to a list index said `water.layerz has 0 entries`: it is an
+    unknown key, with the nearest valid one (the schema's keys at that level); a valid key the
+    base scene leaves out cannot be indexed; one line, exit 2, before anything runs."""
+    scene = copy.deepcopy(TINY)
+    with pytest.raises(SweepError, match=r"^axes: water\.layerz\[0\]\.a: water\.layerz is an "
+                                         r"unknown key; did you mean water\.layers\?$"):
+        set_key_path(scene, "water.layerz[0].a", 0.1)
+    with pytest.raises(SweepError, match=r"illumination\.skyy is an unknown key; did you mean "
+                                         r"illumination\.sky\?"):
+        set_key_path(scene, "illumination.skyy.x", 1)
+    with pytest.raises(SweepError, match=r"estimator\.foo is an unknown key; allowed keys there: "
+                                         r".*split_weight"):
+        set_key_path(scene, "estimator.foo.bar", 1)
+    with pytest.raises(SweepError, match=r"the base scene has no tallies\.local_directions_deg, "
+                                         r"so \[0\] does not apply"):
+        set_key_path(scene, "tallies.local_directions_deg[0]", [180, 0])
+    scene = copy.deepcopy(TINY)
+    set_key_path(scene, "surface.n_water", 1.34)     # a key the base scene leaves out: created
+    assert scene == {**TINY, "surface": {"n_water": 1.34}}
+    path = sweep_file(tmp_path, {"water.layerz[0].a": [0.1, 0.2]})
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", path, "-o", "lut.nc"],
+                          cwd=tmp_path, env=ENV, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == ("oceanmc: config error: axes: water.layerz[0].a: water.layerz is an "
+                           "unknown key; did you mean water.layers?\n")
+    assert not (tmp_path / "lut.nc").exists() and not (tmp_path / "lut.points").exists()
+
+
 def test_axes_product_zip_and_generators(tmp_path):
     spec = load_sweep(sweep_file(tmp_path, {
         "water.layers[0].a": {"geomspace": [0.01, 1.0, 3]},
