@@ -1,6 +1,7 @@
 """Bad data in a scene's tables and keys (issue 29, sections 1 and 2): one line naming the key,
 the value and what is allowed, exit status 2 and no results file; never a traceback, never NaN
 results with exit 0, never a runaway allocation."""
+import resource
 import subprocess
 import sys
 
@@ -184,6 +185,24 @@ def test_component_lists_need_one_value_per_wavelength(component, key, count):
     # a list with one value per wavelength is what is allowed
     component = dict(component, **{key: [0.01, 0.02, 0.03]})
     assert oceanmc.load_config(scene([component])).water.layers[0].components[1]
+
+
+@pytest.mark.parametrize("profile, key", [
+    ({"model": "chlorophyll", "chl_mg_m3": {"profile": "gaussian", "background": 0.1,
+                                            "peak_depth_m": 5, "width_m": 1e-9,
+                                            "integral": 1e-9}}, "chl_mg_m3"),
+    ({"model": "cdom", "a440": {"profile": "linear", "depths_m": [0, 1e-9, 1e6],
+                                "values": [0.1, 0.1, 0.2]}}, "a440"),
+])
+def test_profile_needing_too_many_sublayers_is_refused_before_allocation(tmp_path, capsys,
+                                                                         profile, key):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    err = refused_run(tmp_path, capsys, scene([profile], thickness=1e6),
+                      f"water.layers[0].components[1].{key}: its length scale of 1e-09 m",
+                      "allowed: at most 5000")
+    assert "e+" in err.split("needs ")[1]   # the count, e.g. 5e+09 sublayers
+    # nothing near the 37 GiB of intervals was allocated (ru_maxrss in KiB on Linux)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 500_000
 
 
 def test_one_row_profile_table_is_refused(tmp_path, capsys):

@@ -150,8 +150,9 @@ class _Constituents:
         return max(profiles.constant_below(p, f"{self.where[k]}.{key}")
                    for k, key, p in self.profiled)
 
-    def step(self) -> float:
-        return min(profiles.length_scale(p, f"{self.where[k]}.{key}")
+    def step(self) -> tuple[float, str]:
+        """The profiles' shortest length scale (m) and the key of the profile that has it."""
+        return min((profiles.length_scale(p, f"{self.where[k]}.{key}"), f"{self.where[k]}.{key}")
                    for k, key, p in self.profiled)
 
 
@@ -160,10 +161,16 @@ def _resolve(parts: _Constituents, top: float, bottom: float, where: str
     """(top, bottom, IOPs) of the sublayers of [top, bottom] (finite): intervals no longer than
     the profiles' length scale, cut at their nodes, halved until the optical-depth bound holds."""
     cuts = np.concatenate([[top], parts.breakpoints(top, bottom), [bottom]])
+    step, key = parts.step()
+    # counted before anything is allocated (a 1e-9 m gaussian over 10 m: 1e10 intervals)
+    spans = [max(1.0, (z1 - z0) / step) for z0, z1 in zip(cuts[:-1], cuts[1:])]
+    if sum(spans) > MAX_SUBLAYERS:
+        raise ConfigError(f"{key}: its length scale of {step:g} m (a gaussian's width_m, or the "
+                          f"closest two depths) over {bottom - top:g} m of {where} needs "
+                          f"{sum(spans):.3g} sublayers; allowed: at most {MAX_SUBLAYERS}")
     pending = []
-    for z0, z1 in zip(cuts[:-1], cuts[1:]):
-        n = max(1, math.ceil((z1 - z0) / parts.step()))
-        edges = np.linspace(z0, z1, n + 1)
+    for z0, z1, n in zip(cuts[:-1], cuts[1:], spans):
+        edges = np.linspace(z0, z1, math.ceil(n) + 1)
         pending += list(zip(edges[:-1], edges[1:]))
     out = []
     pending.reverse()
