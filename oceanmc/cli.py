@@ -186,20 +186,14 @@ def cmd_run(args: argparse.Namespace) -> int:
         result.save(out, overwrite=replace["ok"])
         print(format_summary(result))
         print(f"  wrote {out}")
-        if result.attrs.get("partial"):
-            total = config.batches
-            done = int(result.attrs["batches"])
+        if result.attrs.get("partial"):   # the summary's PARTIAL line says how much is whole
             unfinished = result.resume_state
-            begun = "" if unfinished is None else \
-                f"; {len(unfinished['batch'])} more begun, kept to be continued"
-            print(f"  PARTIAL: {done} of {total} batches whole ({result.attrs['photons']:,} "
-                  f"photons; the estimates use whole batches only){begun}; continue with: "
-                  f"oceanmc run {path} -o {out} --resume"
+            n = 0 if unfinished is None else len(unfinished["batch"])
+            begun = f"{n} more batch{'es' if n > 1 else ''} begun, kept to be continued; " \
+                if n else ""
+            print(f"  {begun}continue with: oceanmc run {path} -o {out} --resume"
                   + "".join(f" --{key} {value}" for key, value in overrides.items()
                             if value is not None))
-            if done == 0:
-                print("  no batch is whole yet: the file holds no estimate, only the state to "
-                      "resume from")
         print()
         if stop.requested:
             print(f"oceanmc: stopped by {stop.signal_name}", file=sys.stderr)

@@ -232,3 +232,44 @@ def test_raw_tally_rows_of_an_earlier_oceanmc_are_refused(tmp_path, small_scene,
     assert "raw tally rows" in message and "cannot be continued" in message, message
     assert f"{part.attrs['batches']} whole batches stay readable" in message, message
     assert out.read_bytes() == before
+
+
+def test_partial_summary_says_how_many_batches_and_that_few_give_unreliable_errors(
+        tmp_path, small_scene, capsys):
+    """`oceanmc show` (and the summary `oceanmc run` prints after a stop) of a partial file
+    says, in one line, how many of the scene's batches are whole, and that standard errors from
+    fewer than 8 batches are unreliable; so does a complete run of fewer than 8 batches."""
+    from oceanmc.cli import main
+    from oceanmc.run.results import RELIABLE_BATCHES, format_summary
+
+    small_scene.update(photons=4000, batches=8)
+    full = oceanmc.simulate(small_scene, threads=1)
+    assert RELIABLE_BATCHES == 8
+    assert "PARTIAL" not in format_summary(full) and "unreliable" not in format_summary(full)
+
+    def cut(whole, partial=True):
+        part = load_result(full.save(tmp_path / "full.h5"))
+        for q in part.quantities.values():
+            q.batches = q.batches[:whole]
+        part.attrs.update(batches=whole, partial=partial,
+                          photons=whole * int(part.attrs["photons_per_batch"]))
+        return part.save(tmp_path / f"cut{whole}{partial}.h5")
+
+    def shown(path):
+        assert main(["show", str(path)]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        said = [line for line in lines if "PARTIAL" in line or "note:" in line]
+        assert len(said) == 1 and lines.index(said[0]) == 2, lines
+        return said[0]
+
+    assert shown(cut(2)) == ("  PARTIAL: 2 of 8 batches whole (a stopped run; the estimates use "
+                             "them only); standard errors from fewer than 8 batches are "
+                             "unreliable")
+    assert shown(cut(0)).endswith("0 of 8 batches whole (a stopped run; the estimates use them "
+                                  "only); no batch is whole yet: the file holds no estimate, "
+                                  "only the state to resume from")
+    assert shown(cut(4, partial=False)) == ("  note: 4 batches; standard errors from fewer than 8 "
+                                            "batches are unreliable")
+    main(["show", str(full.save(tmp_path / "whole.h5"))])
+    out = capsys.readouterr().out
+    assert "PARTIAL" not in out and "unreliable" not in out

@@ -477,6 +477,36 @@ def format_spectrum(result: Result) -> list[str]:
     return lines
 
 
+# standard errors from fewer batches than this are themselves too uncertain to trust: from n
+# batches the standard error's own relative error is about 1 / sqrt(2 (n - 1)), 38% at 4
+RELIABLE_BATCHES = 8
+
+
+def completeness_line(result: Result) -> str | None:
+    """One line on a partial file (N of M batches whole) and on standard errors from fewer than
+    RELIABLE_BATCHES batches; None for a complete file of enough batches."""
+    a = result.attrs
+    done = int(a["batches"])
+    if not a.get("partial", False) and done >= RELIABLE_BATCHES:
+        return None
+    import yaml
+    total = None
+    try:
+        total = int(yaml.safe_load(result.config_yaml)["batches"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        pass
+    of = f" of {total}" if total is not None else ""
+    head = f"  PARTIAL: {done}{of} batches whole (a stopped run; the estimates use them only)" \
+        if a.get("partial", False) else f"  note: {done} batches"
+    if done == 0:
+        return head + "; no batch is whole yet: the file holds no estimate, only the state to " \
+            "resume from"
+    if done < RELIABLE_BATCHES:
+        return head + f"; standard errors from fewer than {RELIABLE_BATCHES} batches are " \
+            "unreliable"
+    return head
+
+
 def format_summary(result: Result) -> str:
     a = result.attrs
     lines = [
@@ -485,6 +515,9 @@ def format_summary(result: Result) -> str:
         f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
         f"(start-up {a['startup_time_s']:.2f} s)",
     ]
+    said = completeness_line(result)
+    if said is not None:
+        lines.append(said)
     if "wavelength" in result.coords:
         return "\n".join(lines + format_spectrum(result))
     lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}")
