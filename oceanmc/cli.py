@@ -244,7 +244,7 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    from .plot.results import NEEDS, PlotInputError, plot_result
+    from .plot.results import PlotInputError, plot_result
 
     try:
         written = plot_result(args.file, args.output, depth=args.depth, wavelength=args.wavelength)
@@ -253,9 +253,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise UsageError(f"-o {args.output}: cannot write the figures there ({exc})") from None
     for name, path in written.items():
-        if path is None:
-            print(f"oceanmc: plot: {args.file} has no {NEEDS[name]}; no {name} figure",
-                  file=sys.stderr)
+        if isinstance(path, str):   # why it was not drawn
+            print(f"oceanmc: plot: {args.file} {path}; no {name} figure", file=sys.stderr)
         else:
             print(f"wrote {path}")
     return 0

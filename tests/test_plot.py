@@ -5,6 +5,7 @@ import os
 import struct
 import subprocess
 import sys
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -231,3 +232,78 @@ def test_file_without_radiance_draws_the_rest(mono_file, tmp_path, capsys):
     assert "bare.h5 has no radiance" in captured.err and captured.err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.glob("*.png")) == ["bare_profiles.png",
                                                              "bare_rrs.png"]
+
+
+def _copy(source, target):
+    target.write_bytes(source.read_bytes())
+    return target
+
+
+def test_all_nan_is_refused_and_a_nan_figure_is_left_out(mono_file, tmp_path, capsys):
+    """A file whose every value to plot is NaN (a run stopped before its first whole batch) is
+    refused in one line, exit 2, no PNG; one figure's quantity all NaN: that figure is left out
+    with a one-line note on stderr, the others drawn."""
+    from oceanmc.run.hdf5 import load_result
+    empty = load_result(mono_file)
+    for q in empty.quantities.values():
+        q.batches = q.batches[:0]
+    empty.attrs.update(batches=0, partial=True, photons=0)
+    stopped = empty.save(tmp_path / "stopped.h5")
+    err = one_line_error(capsys, ["plot", str(stopped)])
+    assert "stopped.h5: every value to plot is NaN (a partial file with no whole batch yet" in err
+    assert "nothing to plot" in err and not list(tmp_path.glob("*.png"))
+
+    no_rrs = _copy(mono_file, tmp_path / "no_rrs.h5")
+    with h5py.File(no_rrs, "a") as f:
+        f["air/Rrs_nadir"][...] = np.nan
+    assert main(["plot", str(no_rrs)]) == 0
+    err = capsys.readouterr().err
+    assert err == f"oceanmc: plot: {no_rrs} holds only NaN in air/Rrs_nadir; no rrs figure\n"
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["no_rrs_profiles.png",
+                                                             "no_rrs_radiance.png"]
+
+
+LONG_NAME = ("clear oligotrophic water with Petzold particles and a Fournier-Forand tail over "
+             "a Lambertian sand bottom of reflectance 0.3 at ten metres, sun at 30 deg, 20% sky, "
+             "run for the issue")
+
+
+@pytest.mark.parametrize("which", ["mono", "spectral"])
+def test_a_long_scene_name_fits_in_the_title(mono_file, spectral_file, tmp_path, which):
+    """A scene name of up to 200 characters is wrapped (at most 3 lines, then shortened with
+    '...') so that the title lies inside the figure, which keeps its size."""
+    import matplotlib
+    source = mono_file if which == "mono" else spectral_file
+    named = _copy(source, tmp_path / f"{which}.h5")
+    with h5py.File(named, "a") as f:
+        f.attrs["name"] = LONG_NAME
+    fig = rrs_figure(open_result(named))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    title = fig.axes[0].title
+    box, page = title.get_window_extent(renderer), fig.bbox
+    assert box.x0 >= page.x0 and box.x1 <= page.x1 and box.y1 <= page.y1, (box, page)
+    text = title.get_text()
+    assert text.startswith("remote-sensing reflectance:") and 2 <= text.count("\n") + 1 <= 3
+    assert text.replace("\n", " ").replace(" ...", "") in f"remote-sensing reflectance: " \
+        f"{LONG_NAME}"
+    assert isinstance(fig.canvas, matplotlib.backends.backend_agg.FigureCanvasAgg)
+    close(fig)
+
+
+def test_output_folder_with_or_without_a_trailing_separator(mono_file, tmp_path, capsys):
+    """-o DIR writes DIR/RESULT_*.png when DIR exists (with or without a trailing separator)
+    or when DIR ends in one (created); otherwise -o is a prefix."""
+    existing = tmp_path / "figs"
+    existing.mkdir()
+    for out in (str(existing), str(existing) + os.sep, str(tmp_path / "new") + os.sep):
+        assert main(["plot", str(mono_file), "-o", out]) == 0
+        folder = Path(out.rstrip(os.sep))
+        assert sorted(p.name for p in folder.iterdir()) == ["mono_profiles.png",
+                                                           "mono_radiance.png", "mono_rrs.png"]
+        for png in folder.iterdir():
+            png.unlink()
+    assert main(["plot", str(mono_file), "-o", str(tmp_path / "run1")]) == 0
+    assert sorted(p.name for p in tmp_path.glob("run1*")) == ["run1_profiles.png",
+                                                             "run1_radiance.png", "run1_rrs.png"]
+    capsys.readouterr()

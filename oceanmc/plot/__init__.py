@@ -68,6 +68,23 @@ def polar_quads(ax, theta_edges_deg, phi_edges_deg, values, norm, cmap: str = "v
                          values, norm=norm, cmap=cmap, shading="flat")
 
 
+def fit_title(text: str, width_in: float, fontsize: float, max_lines: int = 3) -> str:
+    """The text wrapped to lines that fit width_in inches at fontsize points (a character of
+    DejaVu Sans is at most about 0.6 em wide on average), at most max_lines of them, the last
+    shortened with '...' if the text is longer: a long scene name in a title stays inside the
+    figure."""
+    import textwrap
+    chars = max(10, int(width_in * 72.0 / (0.6 * fontsize)))
+    lines = []
+    for paragraph in text.split("\n"):
+        lines += textwrap.wrap(paragraph, chars, break_long_words=True) or [""]
+    if len(lines) > max_lines:
+        lines = lines[:max_lines]
+        cut = lines[-1][:chars - 4]
+        lines[-1] = (cut.rsplit(" ", 1)[0] if " " in cut else cut).rstrip() + " ..."
+    return "\n".join(lines)
+
+
 def half_polar(ax, title: str) -> None:
     """A polar axes as the upper half-plane of a plane of incidence: angle 0 up (the normal),
     positive clockwise, -90 to 90 deg."""

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import log_norm, panels, polar_quads, pyplot, save
+from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
 # at most this many wavelengths share a profile panel (evenly spaced over the file's grid), so
 # that the lines stay distinguishable
@@ -136,7 +136,8 @@ def rrs_figure(result: ResultFile):
     err = result.air["Rrs_nadir_stderr"]
     grid = result.wavelengths
     value, se = np.atleast_1d(np.asarray(rrs)), np.atleast_1d(np.asarray(err))
-    fig, (ax,) = panels(1, 1, (6.0, 4.0) if grid is not None else (3.5, 4.0))
+    size = (6.0, 4.0) if grid is not None else (3.5, 4.0)
+    fig, (ax,) = panels(1, 1, size)
     if grid is None:
         ax.errorbar([0.0], value, yerr=se, fmt="o", color="k", capsize=4,
                     label=f"Rrs nadir = {value[0]:.4g} +- {se[0]:.2g}\n(monochromatic run)")
@@ -150,8 +151,9 @@ def rrs_figure(result: ResultFile):
     top = np.nanmax(value + np.nan_to_num(se))
     ax.set_ylim(0.0, 1.3 * top if top > 0 else 1.0)
     ax.set_ylabel(f"Rrs ({rrs.attrs.get('units', 'sr-1')})")
-    ax.set_title(f"remote-sensing reflectance: {result.water.attrs.get('name', result.path.name)}",
-                 fontsize=9)
+    name = result.water.attrs.get("name", result.path.name)
+    # the axes' width (the figure's less the y axis labels): a long scene name is wrapped
+    ax.set_title(fit_title(f"remote-sensing reflectance: {name}", size[0] - 0.9, 9), fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     return fig
@@ -248,13 +250,41 @@ def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
 NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed", "radiance": "radiance (tallies.radiance: false)"}
 
 
+def _drawn_values(result: ResultFile, indices: list[int], depth: int,
+                  wavelength: int | None) -> dict[str, dict[str, np.ndarray]]:
+    """What each figure would draw, by quantity (an empty mapping: the file lacks it)."""
+    lines = indices or [None]
+    drawn: dict[str, dict[str, np.ndarray]] = {"rrs": {}, "profiles": {}, "radiance": {}}
+    if "Rrs_nadir" in result.air:
+        drawn["rrs"]["air/Rrs_nadir"] = np.asarray(result.air["Rrs_nadir"])
+    for name, _ in PROFILE_QUANTITIES:
+        if name in result.water:
+            drawn["profiles"][name] = np.array([np.asarray(_at(result.water[name], i))
+                                                for i in lines])
+    if "radiance" in result.water:
+        drawn["radiance"]["radiance"] = np.asarray(
+            _at(result.water["radiance"], wavelength).isel(depth=depth))
+        if "radiance" in result.air:
+            drawn["radiance"]["air/radiance"] = np.asarray(_at(result.air["radiance"],
+                                                               wavelength))
+    return drawn
+
+
+def _all_nan(values: dict[str, np.ndarray]) -> bool:
+    return bool(values) and all(np.isnan(np.asarray(v, dtype=np.float64)).all()
+                                for v in values.values())
+
+
 def plot_result(path: str | Path, out: str | Path | None = None, depth: float | None = None,
-                wavelength: float | None = None) -> dict[str, Path | None]:
+                wavelength: float | None = None) -> dict[str, Path | str]:
     """Writes the figures of a results file as PNG; returns each figure's path by name (rrs,
-    profiles, radiance), None for one the file has no data for. out: a folder
-    (existing, or ending in '/'), the files then named after the results file, or a prefix to
-    which _rrs.png, _profiles.png, _radiance.png are appended; by default the results file's
-    path without .h5."""
+    profiles, radiance), or, for one not drawn, why: the words that follow the file's name in
+    a note ("has no radiance (...)", "holds only NaN in ..."). A figure whose every value is
+    NaN is not drawn; a file of which nothing can be drawn (every value NaN: a run stopped
+    before its first whole batch) is a PlotInputError. out: a folder (existing, or ending in
+    '/'), the files then named after the results file, or a prefix to which _rrs.png,
+    _profiles.png, _radiance.png are appended; by default the results file's path without
+    .h5."""
     result = open_result(path)
     at_depth = depth_index(result, depth)
     indices = wavelength_indices(result, wavelength)
@@ -262,11 +292,24 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
     radiance_wavelength = None
     if result.wavelengths is not None:
         radiance_wavelength = indices[0] if wavelength is not None else len(result.wavelengths) // 2
-    figures = {"rrs": rrs_figure(result), "profiles": profiles_figure(result, indices),
-               "radiance": radiance_figure(result, at_depth, radiance_wavelength)}
+    drawn = _drawn_values(result, indices, at_depth, radiance_wavelength)
+    skipped: dict[str, str] = {}
+    for name, values in drawn.items():
+        if not values:
+            skipped[name] = f"has no {NEEDS[name]}"
+        elif _all_nan(values):
+            skipped[name] = f"holds only NaN in {', '.join(values)}"
+    if len(skipped) == len(drawn):
+        whole = result.water.attrs.get("batches")
+        why = " (a partial file with no whole batch yet: `oceanmc run --resume` continues " \
+            "it)" if whole is not None and int(whole) == 0 else ""
+        raise PlotInputError(f"{result.path}: every value to plot is NaN{why}; nothing to plot")
+    makers = {"rrs": lambda: rrs_figure(result),
+              "profiles": lambda: profiles_figure(result, indices),
+              "radiance": lambda: radiance_figure(result, at_depth, radiance_wavelength)}
     prefix.parent.mkdir(parents=True, exist_ok=True)
-    return {name: None if fig is None else save(fig, f"{prefix}_{name}.png")
-            for name, fig in figures.items()}
+    return {name: skipped[name] if name in skipped else
+            save(makers[name](), f"{prefix}_{name}.png") for name in drawn}
 
 
 def _prefix(path: Path, out: str | Path | None) -> Path:
