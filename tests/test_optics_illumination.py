@@ -30,8 +30,18 @@ def test_sun_zenith_from_time_and_place():
 def test_sun_below_the_horizon_is_one_line():
     with pytest.raises(ConfigError, match=r"illumination.*sun_position: the sun is .* below the "
                                           r"horizon") as err:
-        scene({"sun_position": {"time": "2024-06-21T00:00:00", "latitude_deg": 40.0,
+        scene({"sun_position": {"time": "2024-06-21T00:00:00Z", "latitude_deg": 40.0,
                                 "longitude_deg": 0.0}})
+    assert "\n" not in str(err.value)
+
+
+def test_a_time_without_its_zone_is_refused():
+    """13:00 read as UTC gave a Mediterranean noon sun 88.7 deg from the zenith: a clock time
+    must say its zone."""
+    with pytest.raises(ConfigError, match=r"illumination.sun_position.time.*has no time zone; "
+                                          r"allowed: .*Z \(UTC\)") as err:
+        scene({"sun_position": {"time": "2024-06-21T13:00:00", "latitude_deg": 40.0,
+                                "longitude_deg": 15.0}})
     assert "\n" not in str(err.value)
 
 

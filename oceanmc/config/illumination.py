@@ -42,7 +42,13 @@ class SkyMap(_Strict):
 SPA_LAST_YEAR = 6000
 
 
-def _spa_years(time: dt.datetime) -> dt.datetime:
+def _sun_time(time: dt.datetime) -> dt.datetime:
+    """A time with its zone (a clock time alone is hours off anywhere but at UTC: 13:00 taken
+    as UTC put a Mediterranean noon sun at 88.7 deg), in the years SPA is valid for."""
+    if time.tzinfo is None:
+        raise ValueError(f"{time.isoformat()} has no time zone; allowed: an ISO 8601 time with "
+                         f"its zone, e.g. {time.isoformat()}Z (UTC) or "
+                         f"{time.isoformat()}+02:00")
     if time.year > SPA_LAST_YEAR:     # datetime's own years start at 1, within SPA's -2000
         raise ValueError(f"year {time.year}; allowed: up to {SPA_LAST_YEAR} (the years the solar "
                          "position algorithm is valid for, -2000 .. 6000)")
@@ -50,9 +56,10 @@ def _spa_years(time: dt.datetime) -> dt.datetime:
 
 
 class SunPosition(_Strict):
-    """The sun's zenith angle from the time (ISO 8601; without a zone it is UTC) and the place
-    (degrees north, degrees east), by pvlib's solar position (NREL SPA, Reda & Andreas 2004)."""
-    time: Annotated[dt.datetime, AfterValidator(_spa_years)]
+    """The sun's zenith angle from the time (ISO 8601 with its zone: Z for UTC, or +hh:mm) and
+    the place (degrees north, degrees east), by pvlib's solar position (NREL SPA, Reda & Andreas
+    2004)."""
+    time: Annotated[dt.datetime, AfterValidator(_sun_time)]
     latitude_deg: Annotated[float, Field(ge=-90.0, le=90.0, allow_inf_nan=False)]
     longitude_deg: Annotated[float, Field(ge=-180.0, le=180.0, allow_inf_nan=False)]
 
