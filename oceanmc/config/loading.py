@@ -7,10 +7,12 @@ import hashlib
 import json
 import os
 import stat
+import textwrap
 import types
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
+import numpy as np
 import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
@@ -314,6 +316,57 @@ def data_file_hashes(config: SceneConfig) -> str:
     return json.dumps(hashes, sort_keys=True)
 
 
-def config_to_yaml(config: SceneConfig) -> str:
-    """The full resolved scene (defaults filled in) as YAML text; load_config reads it back."""
-    return yaml.safe_dump(config.model_dump(), sort_keys=False, allow_unicode=True)
+def config_to_yaml(config: SceneConfig, spectrum: tuple | None = None) -> str:
+    """The full resolved scene (defaults filled in) as YAML text; load_config reads it back.
+
+    A spectrum from a model or a table (illumination.spectrum spectrl2 or table) resolves to
+    Ed(0+) and its diffuse share per wavelength, which the scene's keys do not show (its
+    diffuse_fraction key stays 0): they are written as comments under illumination's
+    diffuse_fraction (YAML comments: the text still loads as the same scene). `spectrum`: the
+    (Ed0, diffuse_fraction) arrays already computed by optics.illumination_spectrum, else they
+    are computed here (and left out if they cannot be)."""
+    text = yaml.safe_dump(config.model_dump(), sort_keys=False, allow_unicode=True)
+    if config.illumination.spectrum.model == "flat":
+        return text
+    if spectrum is None:
+        from ..optics.illumination import illumination_spectrum   # optics imports config
+        try:
+            spectrum = illumination_spectrum(config)[:2]
+        except (ConfigError, OSError, ValueError):
+            return text       # the scene's build reports the problem; nothing to note here
+    note = spectrum_note(config, *spectrum)
+    lines = text.splitlines(keepends=True)
+    start = lines.index("illumination:\n")
+    at = next(i for i in range(start + 1, len(lines))
+              if lines[i].startswith("  diffuse_fraction:"))
+    return "".join(lines[:at + 1] + [f"  # {line}\n" for line in note] + lines[at + 1:])
+
+
+# at most this many wavelengths are listed one by one in the note (beyond: the range and mean)
+NOTE_WAVELENGTHS = 64
+
+
+def spectrum_note(config: SceneConfig, ed0, diffuse) -> list[str]:
+    """Comment lines on what a spectrum model or table resolved to: the diffuse share of Ed(0+)
+    per wavelength (its mean over the band), and Ed(0+) per wavelength."""
+    import numpy as np
+    model = config.illumination.spectrum.model
+    wl = np.asarray(config.wavelengths, dtype=float)
+    ed0, diffuse = np.asarray(ed0, dtype=float), np.asarray(diffuse, dtype=float)
+    source = "SPECTRL2 (Bird & Riordan 1986)" if model == "spectrl2" else "the spectrum table"
+    weighted = float((ed0 * diffuse).sum() / ed0.sum())
+    lines = textwrap.wrap(
+        f"diffuse_fraction is not used with spectrum {model}: {source} gave the sky's share "
+        f"of Ed(0+) per wavelength, as used in this scene: mean {diffuse.mean():.4f} over "
+        f"{wl[0]:g}-{wl[-1]:g} nm ({weighted:.4f} weighted by Ed(0+)), from "
+        f"{diffuse.min():.4f} to {diffuse.max():.4f}", 92)
+
+    if len(wl) > NOTE_WAVELENGTHS:   # the results file's attributes hold every value
+        return lines
+
+    def listing(values, digits):
+        cells = [f"{w:g}: {v:.{digits}g}" for w, v in zip(wl, values)]
+        return ["  " + ", ".join(cells[i:i + 6]) for i in range(0, len(cells), 6)]
+    units = "W m-2 nm-1 times Ed0" if model == "spectrl2" else "the table's Ed0 times Ed0"
+    return lines + ["diffuse share (nm: fraction):"] + listing(diffuse, 4) \
+        + [f"Ed(0+) (nm: {units} = {config.illumination.Ed0:g}):"] + listing(ed0, 5)

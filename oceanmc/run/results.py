@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -416,9 +417,29 @@ def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
 
 # --- the printed summary -----------------------------------------------------------------------
 
+def nadir_estimate(result: Result) -> str:
+    """How Lu, air/Lw_nadir and air/Rrs_nadir were estimated: 'local' (the polar cap's local,
+    next-event estimate; the crossing estimates are beside them as *_crossing) or 'crossing'."""
+    return "local" if "air/Rrs_nadir_crossing" in result else "crossing"
+
+
+def direction_label(result: Result, k: int) -> str:
+    """`180,0`: the exact direction k of local_directions_deg (theta, phi of travel, deg)."""
+    return f"{result.coords['direction_theta'][k]:g},{result.coords['direction_phi'][k]:g}"
+
+
+def local_directions(result: Result) -> range:
+    """The indices of the exact directions with local estimates in air (none: empty)."""
+    return range(len(result.coords.get("direction_theta", ())) if "air/Rrs_local" in result
+                 else 0)
+
+
 def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
-    """(label, units, value, standard error) for the headline quantities of a run."""
+    """(label, units, value, standard error) for the headline quantities of a run; the nadir
+    quantities name their estimator (local or crossing), and each exact direction of
+    local_directions_deg has its Rrs row."""
     rows = []
+    how = f"({nadir_estimate(result)})"
 
     def row(label, name, units, index=None):
         if name not in result:
@@ -430,15 +451,17 @@ def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
 
     row("Ed(0+)", "air/Ed", "W/m2")
     row("Eu(0+)", "air/Eu", "W/m2")
-    row("Lu(0+) nadir", "air/Lu", "W/m2/sr")
-    row("Lw nadir", "air/Lw_nadir", "W/m2/sr")
-    row("Rrs nadir", "air/Rrs_nadir", "1/sr")
+    row("Lu(0+) nadir (crossing)", "air/Lu", "W/m2/sr")
+    row(f"Lw nadir {how}", "air/Lw_nadir", "W/m2/sr")
+    row(f"Rrs nadir {how}", "air/Rrs_nadir", "1/sr")
+    for k in local_directions(result):
+        row(f"Rrs {direction_label(result, k)} (local)", "air/Rrs_local", "1/sr", k)
     for i, depth in enumerate(result.coords["depth"]):
         where = "0-" if depth == 0.0 else f"{depth:g} m"
         row(f"Ed({where})", "Ed", "W/m2", i)
         row(f"Eu({where})", "Eu", "W/m2", i)
         row(f"Eo({where})", "Eo", "W/m2", i)
-        row(f"Lu({where})", "Lu", "W/m2/sr", i)
+        row(f"Lu({where}) {how}", "Lu", "W/m2/sr", i)
     # the budget in the order of budget_terms, as a run makes it (a file read back lists its
     # datasets alphabetically): one order for `run` and `show`
     budget = [name for name in result.quantities if name.startswith("budget/")]
@@ -449,31 +472,95 @@ def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
     return rows
 
 
-# the columns of a spectral run's table: (heading, quantity, depth index or None)
-SPECTRAL_COLUMNS = (("Rrs nadir", "air/Rrs_nadir", None), ("Eu(0+)", "air/Eu", None),
+def estimator_lines(result: Result) -> list[str]:
+    """What the nadir and exact-direction columns or rows are: their quantities, and their
+    estimators."""
+    edges = result.coords.get("theta_edges")
+    cap = f"the {edges[-2]:g}-180 deg polar cap's average" if edges is not None \
+        and len(edges) > 1 else "the nadir polar cap's average"
+    said = []
+    if "air/Rrs_nadir" in result:
+        if nadir_estimate(result) == "local":
+            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate "
+                        "(air/Rrs_nadir_crossing: the crossing estimate)")
+        else:
+            import yaml
+            try:
+                rough = yaml.safe_load(result.config_yaml)["surface"]["model"] == "cox_munk"
+            except (KeyError, TypeError, yaml.YAMLError):
+                rough = False
+            hint = "tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local " \
+                "estimate" if rough else "tallies.nadir_estimator: local gives the local estimate"
+            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
+                        f"through the cap; {hint})")
+    ks = local_directions(result)
+    if len(ks):
+        which = ", ".join(f"Rrs {direction_label(result, k)}" for k in ks)
+        said.append(f"{which}: air/Rrs_local in the exact direction{'s' if len(ks) > 1 else ''} "
+                    "(theta, phi of travel, deg) of tallies.local_directions_deg, local "
+                    "(next-event) estimate")
+    return [line for text in said
+            for line in textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ")]
+
+
+def illumination_lines(result: Result) -> list[str]:
+    """Where Ed(0+) came from, for a spectral file: the sun, the spectrum model or table and
+    the sky's share of Ed(0+) over the band (none if the file does not say)."""
+    import yaml
+    try:
+        light = yaml.safe_load(result.config_yaml)["illumination"]
+        model = light["spectrum"]["model"]
+        zenith = float(light["sun_zenith_deg"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return []
+    diffuse = np.atleast_1d(result.attrs.get("illumination_diffuse_fraction", []))
+    wl = result.coords["wavelength"]
+    where = "sun_position" if light.get("sun_position") else "sun_zenith_deg"
+    line = f"illumination: sun at {zenith:.2f} deg from the zenith ({where}), spectrum {model}"
+    if len(diffuse) == len(wl) and len(wl):
+        line += (f"; sky share of Ed(0+) {diffuse[0]:.3f} at {wl[0]:g} nm .. {diffuse[-1]:.3f} "
+                 f"at {wl[-1]:g} nm, mean {diffuse.mean():.3f}")
+        if model != "flat":
+            line += " (per wavelength: `oceanmc show FILE --config`)"
+    return textwrap.wrap(line, 100, initial_indent="  ", subsequent_indent="    ")
+
+
+# the columns of a spectral run's table: (heading, quantity, depth index or None); the exact
+# directions of local_directions_deg follow Rrs nadir
+SPECTRAL_COLUMNS = (("Ed(0+)", "air/Ed", None), ("Rrs nadir", "air/Rrs_nadir", None),
+                    ("Eu(0+)", "air/Eu", None),
                     ("Ed(z1)", "Ed", 0), ("Eu(z1)", "Eu", 0), ("Eo(z1)", "Eo", 0),
                     ("leaving", "budget/water_leaving", None), ("total", "budget/total", None))
 
 
 def format_spectrum(result: Result) -> list[str]:
     """A spectral run as a table: one row per wavelength, the headline quantities in columns
-    (z1: the first tally depth), each value with its relative standard error in %."""
+    (z1: the first tally depth), each value with its relative standard error in %; then what
+    the Rrs columns are (their estimators) and where the light came from."""
     depths = result.coords["depth"]
     first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
-    columns = [(head.replace("z1", first), name, index)
-               for head, name, index in SPECTRAL_COLUMNS if name in result]
+    columns = []
+    for head, name, index in SPECTRAL_COLUMNS:
+        if name in result:
+            columns.append((head.replace("z1", first), name, (slice(None), index)))
+        if name == "air/Rrs_nadir":
+            columns += [(f"Rrs {direction_label(result, k)}", "air/Rrs_local", (slice(None), k))
+                        for k in local_directions(result)]
     lines = [f"  {'nm':>6}" + "".join(f" {head:>15}" for head, _, _ in columns)]
     for k, wavelength in enumerate(result.coords["wavelength"]):
         cells = []
-        for _, name, index in columns:
+        for _, name, (_, index) in columns:
             value, err = result[name][k], result.stderr(name)[k]
             if index is not None:
                 value, err = value[index], err[index]
             rel = abs(err / value) if value != 0.0 else 0.0
             cells.append(f"{value:>9.4g} {rel:>5.1%}")
         lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>15}" for cell in cells))
-    lines.append("  (value and relative standard error; budget fractions of Ed(0+); every "
-                 "quantity per wavelength in the file)")
+    lines += estimator_lines(result)
+    lines += illumination_lines(result)
+    lines.append("  (value and relative standard error; irradiances in the units of Ed(0+), "
+                 "Rrs in 1/sr,")
+    lines.append("  budget fractions of Ed(0+); every quantity per wavelength in the file)")
     return lines
 
 

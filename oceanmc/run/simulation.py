@@ -157,6 +157,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     work = np.zeros((n_batches, row_floats(work_size(n_wl))))
     raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
     ed0, diffuse, _ = illumination_spectrum(config)
+    # the resolved scene, with what a spectrum model or table gave (Ed0, diffuse share) noted
+    scene_yaml = config_to_yaml(config, (ed0, diffuse))
     args = sc.kernel_args()
     # a batch's lock is held through each of its calls, so that a checkpoint copies its state
     # between two calls
@@ -207,7 +209,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         photons = done * n_per_batch
         attrs = {
             "name": config.name,
-            "config_yaml": config_to_yaml(config),
+            "config_yaml": scene_yaml,
             "data_files_sha256": data_hashes,
             "oceanmc_version": __version__,
             "numba_version": numba.__version__,
@@ -222,6 +224,10 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "startup_time_s": startup,
             "photons_per_s": photons / wall if wall > 0 else float("inf"),
             "scattering_events": int(events[:done].sum()),
+            # Ed(0+) and its diffuse (sky) share per wavelength, as the run used them (from
+            # illumination's Ed0 and diffuse_fraction, or its spectrum model or table)
+            "illumination_Ed0": np.asarray(ed0, dtype=np.float64),
+            "illumination_diffuse_fraction": np.asarray(diffuse, dtype=np.float64),
         }
         reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
