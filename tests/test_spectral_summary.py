@@ -59,6 +59,21 @@ def test_spectral_summary_with_the_local_nadir_estimate_says_so(tmp_path):
     assert "Rrs nadir: air/Rrs_nadir, the 175-180 deg polar cap's average, local (next-event) " \
         "estimate" in text
     assert "Rrs 180,0" not in text     # no local directions asked for
+    # without radiance quads there is no crossing estimate of the cap: the local one is named
+    # all the same (from the file's Lu_method), and no crossing estimate is promised
+    scene["tallies"] = {"depths_m": [0], "nadir_estimator": "local", "radiance": False}
+    result = oceanmc.simulate(scene, threads=1)
+    assert "air/Rrs_nadir_crossing" not in result
+    text = " ".join(format_summary(result).split())
+    assert "local (next-event) estimate" in text and "Rrs_nadir_crossing" not in text
+
+
+def test_a_rough_sea_without_the_exact_nadir_is_told_how_to_get_it():
+    scene = dict(SPECTRAL, surface={"model": "cox_munk", "wind_speed_m_s": 5},
+                 tallies={"depths_m": [0]})
+    text = " ".join(format_summary(oceanmc.simulate(scene, threads=1)).split())
+    assert "crossing estimate (photons leaving through the cap; " \
+        "tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local estimate)" in text
 
 
 def test_show_prints_the_same_summary(spectral_result, tmp_path, capsys):

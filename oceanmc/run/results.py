@@ -419,8 +419,11 @@ def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
 
 def nadir_estimate(result: Result) -> str:
     """How Lu, air/Lw_nadir and air/Rrs_nadir were estimated: 'local' (the polar cap's local,
-    next-event estimate; the crossing estimates are beside them as *_crossing) or 'crossing'."""
-    return "local" if "air/Rrs_nadir_crossing" in result else "crossing"
+    next-event estimate; with radiance quads the crossing estimates are beside them as
+    *_crossing) or 'crossing' (the attribute Lu_method says which)."""
+    method = str(result.attrs.get("Lu_method", ""))
+    local = "local (next-event)" in method if method else "air/Rrs_nadir_crossing" in result
+    return "local" if local else "crossing"
 
 
 def direction_label(result: Result, k: int) -> str:
@@ -481,18 +484,23 @@ def estimator_lines(result: Result) -> list[str]:
     said = []
     if "air/Rrs_nadir" in result:
         if nadir_estimate(result) == "local":
-            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate "
-                        "(air/Rrs_nadir_crossing: the crossing estimate)")
+            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate"
+                        + (" (air/Rrs_nadir_crossing: the crossing estimate)"
+                           if "air/Rrs_nadir_crossing" in result else ""))
         else:
             import yaml
             try:
                 rough = yaml.safe_load(result.config_yaml)["surface"]["model"] == "cox_munk"
             except (KeyError, TypeError, yaml.YAMLError):
                 rough = False
-            hint = "tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local " \
-                "estimate" if rough else "tallies.nadir_estimator: local gives the local estimate"
+            nadir_asked = any(result.coords["direction_theta"][k] == 180.0
+                              for k in local_directions(result))
+            hint = "" if nadir_asked else \
+                "; tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local " \
+                "estimate" if rough else "; tallies.nadir_estimator: local gives the local " \
+                "estimate"
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
-                        f"through the cap; {hint})")
+                        f"through the cap{hint})")
     ks = local_directions(result)
     if len(ks):
         which = ", ".join(f"Rrs {direction_label(result, k)}" for k in ks)
