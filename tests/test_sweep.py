@@ -135,6 +135,44 @@ def test_axes_product_zip_and_generators(tmp_path):
                                                  "water.layers[0].a": [0.1]}}))
 
 
+def test_an_axis_may_have_a_short_name(tmp_path):
+    """`NAME: {key: PATH, values: [...]}` beside `PATH: [...]`, also in a zip group: the axis
+    (the dataset's dimension) and coordinate are named NAME; the sweep's stored text reads
+    back as the same axes."""
+    spec = load_sweep(sweep_file(tmp_path, {
+        "absorption": {"key": "water.layers[0].a", "values": {"linspace": [0.1, 0.3, 3]}},
+        "bottom.reflectance": [0.1, 0.4],
+        "zip": {"sun": {"key": "illumination.sun_zenith_deg", "values": [0, 60]},
+                "illumination.diffuse_fraction": [0.1, 0.3]},
+    }))
+    assert [axis.dim for axis in spec.axes] == ["absorption", "bottom.reflectance", "sun"]
+    assert spec.axes[2].names == ("sun", "illumination.diffuse_fraction")
+    assert spec.axes[0].keys == ("water.layers[0].a",)
+    last = build_points(spec)[-1].config
+    assert last.water.layers[0].a == pytest.approx(0.3)
+    assert last.illumination.sun_zenith_deg == 60
+    again = load_sweep({"base": TINY, **yaml.safe_load(spec.to_yaml())})
+    assert again.axes == spec.axes
+
+
+@pytest.mark.parametrize("axes, message", [
+    ({"depth": {"key": "water.layers[0].thickness_m", "values": [1, 2]}},
+     "depth: the name is taken by the sweep dataset's own"),
+    ({"air_x": {"key": "bottom.reflectance", "values": [0.1]}}, "the name is taken"),
+    ({"chl": {"key": "bottom.reflectance"}}, "values is missing"),
+    ({"chl": {"key": "bottom.reflectance", "values": [0.1], "unit": "1"}}, "unknown key 'unit'"),
+    ({"bottom.reflectance": {"key": "bottom.reflectance", "values": [0.1]}},
+     "a short axis name is letters, digits and _"),
+    ({"a": {"key": "bottom.reflectance", "values": [0.1]},
+      "zip": {"a": {"key": "water.layers[0].a", "values": [0.1]}, "water.layers[0].b": [0.1]}},
+     r"a: the name is given twice \(bottom.reflectance and water.layers\[0\].a\)"),
+    ({"chl": {"key": "bottom..reflectance", "values": [0.1]}}, "is not a key path"),
+])
+def test_a_bad_short_axis_name_is_refused_in_one_line(tmp_path, axes, message):
+    with pytest.raises(SweepError, match=message):
+        load_sweep(sweep_file(tmp_path, axes))
+
+
 def test_every_point_is_validated_first_with_its_coordinates_one_line_exit_2(tmp_path):
     path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2],
                                  "bottom.reflectance": [0.5, 1.5]})

@@ -7,6 +7,9 @@ brackets: `water.layers[0].a`, `bottom.reflectance`, `illumination.sun_zenith_de
 Nothing here knows the scene's schema: a path reaches whatever the base scene's mapping holds,
 so keys added to the schema later are reachable without a change here; the scene's own
 validation (points.py) then judges every value.
+
+An axis is `KEY.PATH: VALUES` (its dimension named by the key path) or `NAME: {key: KEY.PATH,
+values: VALUES}` (named NAME, e.g. `chl`); the same two forms stand inside a `zip` group.
 """
 from __future__ import annotations
 
@@ -137,13 +140,25 @@ def _render(steps: list[str | int]) -> str:
 @dataclass(frozen=True)
 class Axis:
     """One dimension of the sweep: a key path and its values, or a zip group of several key
-    paths whose values vary together (then the dimension is named after the first)."""
+    paths whose values vary together (then the dimension is named after the first). Each key's
+    coordinate is named by its key path, or by the short name given to it (`chl: {key: PATH,
+    values: [...]}`)."""
     keys: tuple[str, ...]
     values: tuple[tuple[Any, ...], ...]   # values[k][i]: key k at position i
+    aliases: tuple[str | None, ...] = ()  # aliases[k]: key k's short name, None: its key path
+
+    def name(self, k: int) -> str:
+        """The coordinate name of key k: its short name, else its key path."""
+        alias = self.aliases[k] if k < len(self.aliases) else None
+        return alias or self.keys[k]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.name(k) for k in range(len(self.keys)))
 
     @property
     def dim(self) -> str:
-        return self.keys[0]
+        return self.name(0)
 
     def __len__(self) -> int:
         return len(self.values[0])
@@ -177,14 +192,22 @@ class SweepSpec:
         return scene
 
     def to_yaml(self) -> str:
-        """The sweep as a YAML text (stored in the dataset's attributes)."""
+        """The sweep as a YAML text (stored in the dataset's attributes; load_sweep reads its
+        axes back)."""
+        def entry(axis: Axis, k: int) -> tuple[str, Any]:
+            values = list(axis.values[k])
+            if axis.name(k) == axis.keys[k]:
+                return axis.keys[k], values
+            return axis.name(k), {"key": axis.keys[k], "values": values}
+
         axes: dict[str, Any] = {}
         zips = []
         for axis in self.axes:
             if len(axis.keys) == 1:
-                axes[axis.keys[0]] = list(axis.values[0])
+                name, value = entry(axis, 0)
+                axes[name] = value
             else:
-                zips.append({key: list(values) for key, values in zip(axis.keys, axis.values)})
+                zips.append(dict(entry(axis, k) for k in range(len(axis.keys))))
         if zips:
             axes["zip"] = zips
         return yaml.safe_dump({"set": self.settings, "axes": axes,
@@ -262,30 +285,73 @@ def _axes(spec: Any) -> tuple[Axis, ...]:
             for group in groups:
                 axes.append(_zip_axis(group))
         else:
-            parse_key_path(key)
-            axes.append(Axis((key,), (_values(key, values),)))
+            path, alias, grid = _entry(key, values)
+            axes.append(Axis((path,), (grid,), (alias,)))
     seen: set[str] = set()
     for axis in axes:
         for key in axis.keys:
             if key in seen:
                 raise SweepError(f"axes: {key} appears twice")
             seen.add(key)
+    names: dict[str, str] = {}
+    for axis in axes:
+        for k, key in enumerate(axis.keys):
+            name = axis.name(k)
+            if name in names or (name != key and name in seen):
+                raise SweepError(f"axes: {name}: the name is given twice ({names.get(name, name)}"
+                                 f" and {key}); each axis and coordinate needs its own name")
+            names[name] = key
     return tuple(axes)
+
+
+# the names of a sweep dataset's own dimensions, coordinates and per-point variables, which a
+# short axis name must not take (a results file's quantities are named as in RESERVED_PREFIXES
+# or RESERVED_NAMES)
+RESERVED_NAMES = frozenset({
+    "depth", "theta", "phi", "theta_edges", "phi_edges", "direction", "direction_theta",
+    "direction_phi", "wavelength", "status", "error", "photons", "wall_time_s", "zip",
+    "Ed", "Eu", "Eod", "Eou", "Eo", "Lu", "Lu_crossing", "local_radiance", "radiance"})
+RESERVED_PREFIXES = ("air_", "budget_")
+_ALIAS = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+ALIAS_KEYS = ("key", "values")
+
+
+def _entry(name: str, spec: Any) -> tuple[str, str | None, tuple[Any, ...]]:
+    """(key path, short name or None, values) of one axis entry: `KEY.PATH: VALUES` or
+    `NAME: {key: KEY.PATH, values: VALUES}` (the dimension or coordinate then named NAME)."""
+    if isinstance(spec, dict) and "key" in spec:
+        unknown = sorted(set(map(str, spec)) - set(ALIAS_KEYS))
+        if unknown or "values" not in spec:
+            raise SweepError(f"axes: {name}: a named axis is {{key: KEY.PATH, values: [...]}}; "
+                             + (f"unknown key {unknown[0]!r}" if unknown
+                                else "values is missing"))
+        if not isinstance(name, str) or not _ALIAS.match(name):
+            raise SweepError(f"axes: {name!r}: a short axis name is letters, digits and _ "
+                             "(not starting with a digit), e.g. chl; it names the dataset's "
+                             "dimension")
+        if name in RESERVED_NAMES or name.startswith(RESERVED_PREFIXES) \
+                or name.endswith("_stderr"):
+            raise SweepError(f"axes: {name}: the name is taken by the sweep dataset's own "
+                             f"dimensions or variables; choose another (e.g. {name}_axis)")
+        path = spec["key"]
+        parse_key_path(path)
+        return path, name, _values(f"{name} ({path})", spec["values"])
+    parse_key_path(name)
+    return name, None, _values(name, spec)
 
 
 def _zip_axis(group: Any) -> Axis:
     if not isinstance(group, dict) or len(group) < 2:
         raise SweepError(f"axes.zip: expected a mapping of two or more key paths to lists of "
                          f"equal length, got {group!r}")
-    keys = tuple(group)
-    for key in keys:
-        parse_key_path(key)
-    values = tuple(_values(key, group[key]) for key in keys)
-    lengths = {key: len(v) for key, v in zip(keys, values)}
+    entries = [_entry(name, spec) for name, spec in group.items()]
+    keys = tuple(path for path, _, _ in entries)
+    values = tuple(grid for _, _, grid in entries)
+    lengths = {name: len(v) for name, v in zip(group, values)}
     if len(set(lengths.values())) > 1:
         raise SweepError(f"axes.zip: the lists must have equal lengths; got "
                          f"{', '.join(f'{k}: {n}' for k, n in lengths.items())}")
-    return Axis(keys, values)
+    return Axis(keys, values, tuple(alias for _, alias, _ in entries))
 
 
 def _values(key: str, values: Any) -> tuple[Any, ...]:

@@ -2,8 +2,9 @@
 dataset (what a rerun skips and a Ctrl-C keeps), and the dataset assembled from them, written
 atomically as NetCDF4 (HDF5, via h5netcdf).
 
-Dataset layout: one dimension per axis (named by its key path; the other keys of a zip group
-are coordinates along it), then each quantity's own dimensions (depth, theta, phi, direction);
+Dataset layout: one dimension per axis (named by its key path, or by its short name; the other
+keys of a zip group are coordinates along it), then each quantity's own dimensions
+(wavelength, depth, theta, phi, and direction when the scene has local_directions_deg);
 every quantity X of the results file (`air/Rrs_nadir` becomes `air_Rrs_nadir`, `budget/total`
 `budget_total`) with `X_stderr` beside it; per point `status` (done, failed, pending), `error`,
 `photons` and `wall_time_s`; the base scene and the sweep in the attributes."""
@@ -117,9 +118,10 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     dims = tuple(axis.dim for axis in spec.axes)
     coords: dict[str, tuple] = {}
     for axis in spec.axes:
-        for key, values in zip(axis.keys, axis.values):
-            coords[key] = (axis.dim, coordinate(values),
-                           {"description": f"the scene's {key} along this axis"})
+        for name, key, values in zip(axis.names, axis.keys, axis.values):
+            coords[name] = (axis.dim, coordinate(values),
+                            {"description": f"the scene's {key} along this axis",
+                             "key_path": key})
     status = np.full(shape, PENDING, dtype=object)
     error = np.full(shape, "", dtype=object)
     photons = np.zeros(shape, dtype=np.int64)
@@ -127,7 +129,12 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     data: dict[str, tuple] = {}
     reference = next((summaries[p.key] for p in points if p.key in summaries), None)
     if reference is not None:
+        # a scene without local_directions_deg has no quantity along `direction`: no empty
+        # dimension for it
+        directions = len(reference.coords.get("direction", ())) > 0
         for name, values in reference.coords.items():
+            if name in ("direction", "direction_theta", "direction_phi") and not directions:
+                continue
             if name in ("direction_theta", "direction_phi"):
                 coords[name] = ("direction", values, _coord_attrs(name))
             elif name not in coords:
