@@ -119,10 +119,15 @@ def test_the_sweep_example_runs_with_named_dimensions_and_no_empty_direction(tmp
     from distributed import Client, LocalCluster
     path = REPO / "configs" / "sweeps" / "shallow_lut.yaml"
     spec = tiny(path)
+    said = []
     with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                       dashboard_address=None) as cluster, Client(cluster) as client:
         ds = oceanmc.sweep(spec, tmp_path / "lut.nc", client=client, threads=1)
+        # a rerun finds both points done: a SPECTRL2 scene's stored text (with its note on
+        # the diffuse share) is the text the sweep expects of the point
+        oceanmc.sweep(spec, tmp_path / "lut.nc", client=client, threads=1, log=said.append)
     assert ds.attrs["points_done"] == 2 and ds.attrs["points_failed"] == 0
+    assert "2 finished earlier, 0 to run" in " ".join(said), said
     # the short names are the dimensions; a440 is a coordinate along chl (a zip group)
     assert ds["air_Rrs_nadir"].dims[:3] == ("chl", "bottom_depth", "bottom.reflectance")
     assert ds["a440"].dims == ("chl",)
