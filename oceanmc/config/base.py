@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 
 class ConfigError(ValueError):
@@ -28,3 +28,13 @@ Coefficient = Annotated[float, Field(ge=0.0, le=MAX_COEFFICIENT, allow_inf_nan=F
 MAX_THICKNESS_M = 1e6
 Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
 Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)]
+
+
+def _no_nul(path: str) -> str:
+    if "\0" in path:   # the operating system cannot take it (a ValueError deep in pathlib)
+        raise ValueError("a file path cannot contain a NUL byte")
+    return path
+
+
+# a data file's path (relative to the YAML file's folder)
+FilePath = Annotated[str, AfterValidator(_no_nul)]

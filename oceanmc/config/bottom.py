@@ -5,7 +5,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from .base import Fraction, _Strict
+from .base import FilePath, Fraction, _Strict
 
 
 class NoBottom(_Strict):
@@ -83,7 +83,7 @@ class TableBottom(_Strict):
     (theta_i, theta_r, dphi) or anisotropic (theta_i, phi_i, theta_r, dphi); values in 1/sr, or
     reflectance factors (pi f) with quantity: reflectance_factor."""
     model: Literal["table"]
-    file: str
+    file: FilePath
     quantity: Literal["brdf", "reflectance_factor"] = "brdf"
     reciprocity_tolerance: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.05
     allow_unphysical: bool = False

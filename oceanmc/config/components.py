@@ -9,7 +9,7 @@ from typing import Annotated, Literal, Union
 from pydantic import (AfterValidator, AliasChoices, Discriminator, Field, PrivateAttr, Tag,
                       model_validator)
 
-from .base import MAX_THICKNESS_M, Coefficient, NonNegative, _Strict
+from .base import MAX_THICKNESS_M, Coefficient, FilePath, NonNegative, _Strict
 from .phase import BasicPhase
 from .wavelengths import BackscatterRatio, spectral
 
@@ -56,7 +56,7 @@ class TableProfile(_Strict):
     """A CSV (or whitespace) file of depth_m, value rows; piecewise linear between them and held
     at the end values outside."""
     profile: Literal["table"]
-    file: str
+    file: FilePath
     # (largest value, unit) of the key it profiles, set by amount(); checked when it is read
     _limit: tuple[float, str] = PrivateAttr(default=(math.inf, ""))
 
@@ -133,7 +133,7 @@ class TableComponent(_Strict):
     """Measured IOPs from a CSV: columns wavelength_nm, a, b, bb_ratio (a and b in 1/m),
     linearly interpolated; Fournier-Forand phase by bb_ratio."""
     model: Literal["table"]
-    file: str
+    file: FilePath
 
 
 class ConstantComponent(_Strict):

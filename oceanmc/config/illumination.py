@@ -6,11 +6,13 @@ from typing import Annotated, Literal, Union
 
 from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 
-from .base import Fraction, _Strict
+from .base import FilePath, Fraction, _Strict
 
 # Ed(0+) in any units, bounded so that it times any tally (tallies hold up to ~1e6 x Ed0) and
-# the batches' variances stay finite; a spectrum's Ed0 times illumination.Ed0 is held to it too
-MAX_ED0 = 1e100
+# the batches' variances stay finite, and from below so that they do not underflow (at Ed0 =
+# 1e-300 every standard error was 0: the squares of the batches' deviations fell below 1e-308);
+# a spectrum's Ed0 times illumination.Ed0 is held to both too
+MIN_ED0, MAX_ED0 = 1e-100, 1e100
 
 
 class SkyMap(_Strict):
@@ -25,7 +27,7 @@ class SkyMap(_Strict):
     (for comparisons). layout (.exr only): what the image's rows cover: sphere (theta_view
     0..180 deg; the upper half is read), hemisphere (0..90 deg), or auto: sphere exactly when
     the image is twice as wide as it is high."""
-    map: str
+    map: FilePath
     dataset: str = "radiance"
     sampling: Literal["importance", "cosine"] = "importance"
     layout: Literal["auto", "hemisphere", "sphere"] = "auto"
@@ -37,6 +39,13 @@ class SkyMap(_Strict):
                              "to .exr images; a .npy, .npz or HDF5 map covers theta_view "
                              "0..90 deg (or its own theta_edges_deg); leave layout out")
         return self
+
+
+def _ed0_floor(ed0: float) -> float:
+    if ed0 < MIN_ED0:   # pydantic would write 1e-100 out in 100 decimals
+        raise ValueError(f"allowed: {MIN_ED0:g} .. {MAX_ED0:g} (below {MIN_ED0:g} the "
+                         "variances of the tallies underflow to 0)")
+    return ed0
 
 
 SPA_LAST_YEAR = 6000
@@ -99,7 +108,7 @@ class TableSpectrum(_Strict):
     """A CSV with columns wavelength_nm, Ed0 (times illumination.Ed0) and diffuse_fraction,
     linearly interpolated."""
     model: Literal["table"]
-    file: str
+    file: FilePath
 
 
 Spectrum = Annotated[Union[FlatSpectrum, Spectrl2Spectrum, TableSpectrum],
@@ -110,7 +119,8 @@ class Illumination(_Strict):
     """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
     Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
     sun_zenith_deg); or {map: FILE} (sky_maps.py)."""
-    Ed0: Annotated[float, Field(gt=0.0, le=MAX_ED0, allow_inf_nan=False)] = 1.0
+    Ed0: Annotated[float, Field(gt=0.0, le=MAX_ED0, allow_inf_nan=False),
+                   AfterValidator(_ed0_floor)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
     sky: Annotated[Union[Annotated[Literal["uniform", "cardioidal", "overcast",

@@ -5,7 +5,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from .base import Asymmetry, Fraction, NonNegative, _Strict
+from .base import Asymmetry, Coefficient, FilePath, Fraction, _Strict
 
 
 class Isotropic(_Strict):
@@ -48,7 +48,7 @@ class Petzold(_Strict):
 class TablePhase(_Strict):
     """A user table: a CSV or whitespace file of (scattering angle in deg, phase value) rows."""
     model: Literal["table"]
-    file: str
+    file: FilePath
 
 
 BasicPhase = Annotated[
@@ -59,7 +59,7 @@ BasicPhase = Annotated[
 
 
 class MixtureComponent(_Strict):
-    b: NonNegative
+    b: Coefficient        # 1/m, as a layer's b (0 .. 1e6)
     phase: BasicPhase
 
 

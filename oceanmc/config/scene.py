@@ -15,10 +15,12 @@ from .tallies import Tallies
 from .water import Water
 from .wavelengths import Wavelengths, check_increasing, grid
 
+MAX_PHOTONS = 10**13
+
 
 class SceneConfig(_Strict):
     name: str = "oceanmc scene"
-    photons: Annotated[int, Field(gt=0, le=10**13)] = 1_000_000
+    photons: Annotated[int, Field(gt=0, le=MAX_PHOTONS)] = 1_000_000
     seed: Annotated[int, Field(ge=0, lt=2**63)] = 1
     batches: Annotated[int, Field(ge=2, le=100_000)] = 32
     illumination: Illumination = Field(default_factory=Illumination)
@@ -56,9 +58,10 @@ class SceneConfig(_Strict):
                 number = float(value)
             except ValueError:
                 return value
-            if math.isfinite(number) and number == int(number):
-                return int(number)
-        elif isinstance(value, float) and math.isfinite(value) and value == int(value):
+            value = number if math.isfinite(number) else value
+        if isinstance(value, float) and math.isfinite(value) and value == int(value):
+            if abs(value) > MAX_PHOTONS:   # else shown as the 309 digits of int(1e308)
+                raise ValueError(f"allowed: 1 .. {MAX_PHOTONS:.0e}")
             return int(value)
         return value
 
@@ -66,8 +69,10 @@ class SceneConfig(_Strict):
     def _consistent(self) -> "SceneConfig":
         deep = math.isinf(self.water.layers[-1].thickness_m)
         if deep and self.bottom.model != "none":
-            raise ValueError(f"bottom.model = {self.bottom.model!r} below an infinitely deep last "
-                             "layer: use bottom.model = 'none'")
+            raise ValueError(f"water.layers[{len(self.water.layers) - 1}].thickness_m = .inf "
+                             f"with bottom.model = {self.bottom.model!r}: no bottom lies below "
+                             "an infinitely deep last layer; use bottom.model = 'none' or a "
+                             "finite thickness_m")
         if not deep and self.bottom.model == "none":
             raise ValueError("bottom.model = 'none' needs an infinitely deep last layer "
                              "(thickness_m: .inf); a finite water column needs a bottom "

@@ -8,7 +8,7 @@ from typing import Annotated
 
 from pydantic import Field, field_validator, model_validator
 
-from .base import MAX_THICKNESS_M, Coefficient, _Strict
+from .base import MAX_COEFFICIENT, MAX_THICKNESS_M, Coefficient, _Strict
 from .components import Component
 from .phase import Isotropic, Mixture, Phase
 from .wavelengths import BackscatterRatio, spectral
@@ -54,6 +54,9 @@ class Layer(_Strict):
         if isinstance(self.phase, Mixture):
             total = sum(c.b for c in self.phase.components)
             if self.b is None:
+                if total > MAX_COEFFICIENT:
+                    raise ValueError(f"phase.components: their b add up to {total:g} 1/m, the "
+                                     f"layer's b; allowed: at most {MAX_COEFFICIENT:g} 1/m")
                 self.b = total
             elif isinstance(self.b, list):
                 raise ValueError("b is a list with phase.model = 'mixture', whose components "

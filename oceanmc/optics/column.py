@@ -163,11 +163,15 @@ def _resolve(parts: _Constituents, top: float, bottom: float, where: str
     cuts = np.concatenate([[top], parts.breakpoints(top, bottom), [bottom]])
     step, key = parts.step()
     # counted before anything is allocated (a 1e-9 m gaussian over 10 m: 1e10 intervals)
-    spans = [max(1.0, (z1 - z0) / step) for z0, z1 in zip(cuts[:-1], cuts[1:])]
-    if sum(spans) > MAX_SUBLAYERS:
+    # (Python floats: a step near 1e-308 gives inf, where numpy's would print an overflow
+    # warning beside the one-line refusal)
+    spans = [max(1.0, float(z1 - z0) / step) for z0, z1 in zip(cuts[:-1], cuts[1:])]
+    count = sum(spans)
+    if count > MAX_SUBLAYERS:
+        count = f"{count:.3g}" if math.isfinite(count) else "more than 1e+308"
         raise ConfigError(f"{key}: its length scale of {step:g} m (a gaussian's width_m, or the "
                           f"closest two depths) over {bottom - top:g} m of {where} needs "
-                          f"{sum(spans):.3g} sublayers; allowed: at most {MAX_SUBLAYERS}")
+                          f"{count} sublayers; allowed: at most {MAX_SUBLAYERS}")
     pending = []
     for z0, z1, n in zip(cuts[:-1], cuts[1:], spans):
         edges = np.linspace(z0, z1, math.ceil(n) + 1)

@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import config as cfg
 from ..config import ConfigError
-from ..config.illumination import MAX_ED0
+from ..config.illumination import MAX_ED0, MIN_ED0
 from ..config.wavelengths import MAX_WAVELENGTH_NM, MIN_WAVELENGTH_NM
 from .tables import interpolate, read_table
 
@@ -71,6 +71,10 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
         raise ConfigError(f"illumination.Ed0 = {light.Ed0:g} times the spectrum's Ed0 reaches "
                           f"{ed0.max():g} at {wl[np.argmax(ed0)]:g} nm; allowed: at most "
                           f"{MAX_ED0:g}")
+    if ed0.min() < MIN_ED0:
+        raise ConfigError(f"illumination.Ed0 = {light.Ed0:g} times the spectrum's Ed0 falls to "
+                          f"{ed0.min():g} at {wl[np.argmin(ed0)]:g} nm; allowed: at least "
+                          f"{MIN_ED0:g}")
     return ed0, diffuse, zenith
 
 

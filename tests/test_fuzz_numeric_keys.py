@@ -1,0 +1,472 @@
+"""Every numeric key of the scene schema with NaN, +-inf, 1e308, 1e-308, -1, 0 and its own
+bounds (issue 29, section 6): each value loads or is refused in one line (ConfigError) that names
+the key or the value; a scene that loads runs (200 photons, 2 batches) to finite estimates and
+standard errors, or is refused in one line by the scene build, never NaN with success.
+
+The keys are not listed here: they are found by walking the pydantic models of oceanmc/config
+(every field whose type holds a number, in every model a template scene reaches, lists entry by
+entry), so a key added to a model is fuzzed without a change here; a model no template reaches
+fails test_every_numeric_key_of_the_schema_is_reached (add it to a template). Below them, one
+named test per class of failure the fuzzing found."""
+import copy
+import math
+import warnings
+from typing import get_args
+
+import numpy as np
+import pytest
+from pydantic import BaseModel
+
+import oceanmc
+from oceanmc.config import ConfigError, SceneConfig, load_config
+
+VALUES = (math.nan, math.inf, -math.inf, 1e308, 1e-308, -1, 0)
+TINY_RUN = {"photons": 200, "batches": 2}
+
+
+def _mono(**changes):
+    scene = {"photons": 200, "batches": 2, "seed": 3,
+             "illumination": {"Ed0": 1.0, "sun_zenith_deg": 30, "diffuse_fraction": 0.2},
+             "surface": {"model": "flat", "n_water": 1.34},
+             "water": {"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4,
+                                   "phase": {"model": "henyey_greenstein", "g": 0.8}}]},
+             "bottom": {"model": "lambertian", "reflectance": 0.3},
+             "tallies": {"depths_m": [0, 1, 2], "phi_bands": 12, "grazing_mu_cut": 0.01,
+                         "theta_edges_deg": [0, 10, 90, 170, 180],
+                         "local_directions_deg": [[180, 0]]},
+             "estimator": {"roulette_weight": 1e-3, "roulette_survival": 0.1,
+                           "max_events": 10000, "split_weight": 2.0, "upward_fraction": 0.1,
+                           "upward_cone_deg": 15}}
+    scene.update(changes)
+    return scene
+
+
+SMALL_TALLIES = {"depths_m": [0, 1]}
+
+
+def templates(folder):
+    """{name: scene} reaching every model of the schema; data files written in folder."""
+    (folder / "iops.csv").write_text("wavelength_nm,a,b,bb_ratio\n350,0.1,0.2,0.02\n"
+                                     "800,0.2,0.1,0.01\n")
+    (folder / "profile.csv").write_text("depth_m,value\n0,0.5\n1,0.6\n")
+    (folder / "spectrum.csv").write_text("wavelength_nm,Ed0,diffuse_fraction\n350,1,0.2\n"
+                                         "800,1.5,0.1\n")
+    (folder / "phase.csv").write_text("0,10\n10,1\n90,0.1\n180,0.1\n")
+    angles = np.arange(0.0, 90.1, 10.0)
+    np.savez(folder / "brdf.npz", theta_i_deg=angles, theta_r_deg=angles,
+             phi_deg=np.arange(0.0, 180.1, 30.0), brdf=np.full((10, 10, 7), 0.3 / np.pi))
+    np.save(folder / "sky.npy", np.ones((9, 36)))
+    f = {name: str(folder / name) for name in ("iops.csv", "profile.csv", "spectrum.csv",
+                                                  "phase.csv", "brdf.npz", "sky.npy")}
+    return {
+        "hg_lambertian": _mono(),
+        "constituents_minnaert": _mono(
+            wavelengths_nm=[400, 500, 600],
+            water={"layers": [{"thickness_m": 1.0, "components": [
+                {"model": "pure_water"},
+                {"model": "chlorophyll", "chl_mg_m3": {"profile": "gaussian", "background": 0.1,
+                                                       "peak_depth_m": 0.5, "width_m": 2.0,
+                                                       "integral": 0.1}},
+                {"model": "cdom", "a440": {"profile": "linear", "depths_m": [0, 1],
+                                           "values": [0.05, 0.06]}, "slope": 0.014},
+                {"model": "particles", "b550": 0.5, "exponent": 1.0, "bb_ratio": 0.0183,
+                 "a443": 0.02, "slope": 0.011, "concentration": 1.0},
+                {"model": "constant", "a": 0.01, "b": 0.02, "bb_ratio": 0.02,
+                 "concentration": 1.0},
+                {"model": "table", "file": f["iops.csv"]},
+                {"model": "chlorophyll", "chl_mg_m3": {"profile": "table",
+                                                       "file": f["profile.csv"]}}]}]},
+            bottom={"model": "minnaert", "reflectance": 0.2, "k": 0.5}, tallies=SMALL_TALLIES),
+        "sun_spectrl2": _mono(   # pvlib's solar position: 80 ms a load
+            wavelengths_nm=[400, 600], tallies=SMALL_TALLIES,
+            illumination={"Ed0": 1.0, "spectrum": {"model": "spectrl2", "day_of_year": 100},
+                          "sun_position": {"time": "2024-06-21T12:00:00Z", "latitude_deg": 40.0,
+                                           "longitude_deg": 0.0}}),
+        "lists_cox_munk_wind": _mono(
+            wavelengths_nm={"start": 400, "stop": 600, "step": 100},
+            illumination={"Ed0": 2.0, "sun_zenith_deg": 40,
+                          "spectrum": {"model": "table", "file": f["spectrum.csv"]}},
+            surface={"model": "cox_munk", "n_water": 1.34, "wind_speed_m_s": 5.0,
+                     "wind_direction_deg": 30.0},
+            water={"layers": [{"thickness_m": 3.0, "a": [0.1, 0.2, 0.3], "b": [0.3, 0.2, 0.1],
+                               "bb_ratio": [0.01, 0.02, 0.03]}]},
+            bottom={"model": "black"},
+            tallies={"depths_m": [0, 1], "phi_bands": 12, "local_directions_deg": [[170, 30]]}),
+        "ggx": _mono(bottom={"model": "ggx", "roughness": 0.3, "n_ratio": 1.15,
+                             "diffuse_reflectance": 0.1}, tallies=SMALL_TALLIES),
+        "ff_hapke_slope": _mono(
+            surface={"model": "cox_munk", "mean_square_slope": 0.02},
+            water={"layers": [{"thickness_m": 1.0, "a": 0.2, "b": 0.5,
+                               "phase": {"model": "fournier_forand", "bb_ratio": 0.02}},
+                              {"thickness_m": 1.0, "a": 0.1, "b": 0.3,
+                               "phase": {"model": "two_term_hg", "g1": 0.9, "g2": -0.3,
+                                         "alpha": 0.9}}]},
+            bottom={"model": "hapke", "albedo": 0.5, "asymmetry": 0.1,
+                    "opposition_amplitude": 0.5, "opposition_width": 0.06},
+            tallies=SMALL_TALLIES),
+        "mixture_lambertian_specular": _mono(
+            water={"layers": [{"thickness_m": 2.0, "a": 0.1, "phase": {
+                "model": "mixture", "components": [{"b": 0.1, "phase": {"model": "pure_water"}},
+                                                   {"b": 0.3, "phase": {"model": "petzold"}}]}}]},
+            bottom={"model": "lambertian_specular", "diffuse_reflectance": 0.2,
+                    "specular_reflectance": 0.1},
+            tallies={"depths_m": [0, 1], "nadir_estimator": "crossing"}),
+        "files": _mono(
+            illumination={"Ed0": 1.0, "sun_zenith_deg": 30, "diffuse_fraction": 0.3,
+                          "sky": {"map": f["sky.npy"]}},
+            water={"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4,
+                               "phase": {"model": "table", "file": f["phase.csv"]}}]},
+            bottom={"model": "table", "file": f["brdf.npz"], "reciprocity_tolerance": 0.05},
+            tallies=SMALL_TALLIES),
+        "deep": _mono(water={"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 0.2,
+                                         "phase": {"model": "rayleigh"}},
+                                        {"thickness_m": math.inf, "a": 0.2, "b": 0.1}]},
+                      bottom={"model": "none"}, tallies=SMALL_TALLIES),
+        "specular": _mono(bottom={"model": "specular", "reflectance": 0.5},
+                          tallies=SMALL_TALLIES),
+    }
+
+
+# templates whose scene build costs 0.1-1 s (a BRDF's tabulated sampler): only the first
+# accepted extreme value of each of their keys is run
+COSTLY = {"ggx", "ff_hapke_slope", "files"}
+
+# accepted values whose run fails (NaN results or a traceback) for a reason outside the schema
+# and the readers: each is the subject of a strict xfail test below (when it is fixed, that test
+# passes and its entries here go)
+KNOWN = {
+    # kernel/spectral.py: a wavelength whose b is subnormal overflows 1 / beta_h (hero's)
+    ("lists_cox_munk_wind", "water.layers[0].b[0]", 1e-308): "nan",
+    ("lists_cox_munk_wind", "water.layers[0].b[2]", 1e-308): "nan",
+    # kernel/spectral.py: a wavelength scattering far more than the others: the deferred
+    # exponentials overflow while the K_j underflow (0 x inf)
+    ("lists_cox_munk_wind", "water.layers[0].b[0]", 1e6): "nan",
+    ("lists_cox_munk_wind", "water.layers[0].b[2]", 1e6): "nan",
+    # run/results.py: no upwelling light at 0- at one wavelength: air/t_up missing (KeyError)
+    ("lists_cox_munk_wind", "water.layers[0].a[0]", 1e6): "KeyError",
+    ("lists_cox_munk_wind", "water.layers[0].a[2]", 1e6): "KeyError",
+}
+
+
+# --- walking the schema -----------------------------------------------------------------------
+
+def holds_number(annotation) -> bool:
+    if annotation in (int, float):
+        return True
+    if isinstance(annotation, type):
+        return False
+    return any(holds_number(arg) for arg in get_args(annotation) if not isinstance(arg, str))
+
+
+def schema_models(tp=SceneConfig, found=None) -> set:
+    found = set() if found is None else found
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        if tp not in found:
+            found.add(tp)
+            for field in tp.model_fields.values():
+                schema_models(field.annotation, found)
+        return found
+    for arg in get_args(tp):
+        schema_models(arg, found)
+    return found
+
+
+def numeric_fields() -> set[tuple[str, str]]:
+    return {(model.__name__, name) for model in schema_models()
+            for name, field in model.model_fields.items() if holds_number(field.annotation)}
+
+
+def leaves(obj, path=()):
+    """(path, model class, field name) of every numeric value under a validated model: scalars,
+    and the first and last entries of lists (each number of a pair)."""
+    for name, field in type(obj).model_fields.items():
+        value = getattr(obj, name)
+        here = path + (name,)
+        if isinstance(value, BaseModel):
+            yield from leaves(value, here)
+        elif isinstance(value, list) and value and isinstance(value[0], BaseModel):
+            for i, item in enumerate(value):
+                yield from leaves(item, here + (i,))
+        elif holds_number(field.annotation):
+            if not isinstance(value, (list, tuple)):
+                yield here, type(obj), name
+                continue
+            for i in sorted({0, len(value) - 1} if value else ()):
+                if isinstance(value[i], (list, tuple)):
+                    yield from ((here + (i, j), type(obj), name) for j in range(len(value[i])))
+                else:
+                    yield here + (i,), type(obj), name
+
+
+def models_reached(obj, found=None) -> set:
+    found = set() if found is None else found
+    found.add(type(obj))
+    for name in type(obj).model_fields:
+        value = getattr(obj, name)
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, BaseModel):
+                models_reached(item, found)
+    return found
+
+
+def bounds(annotation) -> set[float]:
+    """The values at the edges of the ranges an annotation allows (ge, le themselves; the
+    next float inside gt, lt)."""
+    out = set()
+    for meta in getattr(annotation, "__metadata__", ()):
+        for constraint in [meta] + list(getattr(meta, "metadata", ())):
+            for kind, step in (("ge", None), ("le", None), ("gt", math.inf), ("lt", -math.inf)):
+                edge = getattr(constraint, kind, None)
+                if isinstance(edge, (int, float)) and math.isfinite(edge) and abs(edge) < 1e300:
+                    out.add(float(edge) if step is None else math.nextafter(edge, step))
+    for arg in get_args(annotation):
+        if not isinstance(arg, (str, int, float)):
+            out |= bounds(arg)
+    return out
+
+
+def with_value(scene: dict, path: tuple, value) -> dict:
+    """A copy of the scene with the value at path (mappings on the way created)."""
+    scene = copy.deepcopy(scene)
+    node = scene
+    for key in path[:-1]:
+        if isinstance(key, str) and node.get(key) is None:
+            node[key] = {}
+        node = node[key]
+    node[path[-1]] = value
+    return scene
+
+
+def render(path: tuple) -> str:
+    text = ""
+    for key in path:
+        text += f"[{key}]" if isinstance(key, int) else ("." if text else "") + key
+    return text
+
+
+def shown(value) -> tuple[str, ...]:
+    """How a message may write the value."""
+    return (repr(value), f"{value:g}", str(value), repr(float(value)))
+
+
+def finite(result) -> list[str]:
+    return [name for name, q in result.quantities.items()
+            if not (np.all(np.isfinite(q.mean)) and np.all(np.isfinite(q.stderr)))]
+
+
+def one_line(message: str) -> None:
+    assert message and "\n" not in message.strip() and "Traceback" not in message, message
+
+
+@pytest.fixture(scope="module")
+def scenes(tmp_path_factory):
+    return templates(tmp_path_factory.mktemp("fuzz_numeric"))
+
+
+def test_every_numeric_key_of_the_schema_is_reached(scenes):
+    """Every model of the schema appears in a template, so every numeric field is fuzzed."""
+    reached = set()
+    for scene in scenes.values():
+        reached |= {m.__name__ for m in models_reached(load_config(copy.deepcopy(scene)))}
+    missing = {model for model, _ in numeric_fields()} - reached
+    assert not missing, f"add these models to a template of tests/test_fuzz_numeric_keys.py: " \
+                        f"{sorted(missing)}"
+    assert len(numeric_fields()) >= 79
+
+
+# (model, field, list indices) fuzzed by an earlier template: each key is fuzzed in the first
+# template that reaches it (the templates run in this order)
+FUZZED: set = set()
+TEMPLATES = ["hg_lambertian", "constituents_minnaert", "sun_spectrl2", "lists_cox_munk_wind",
+             "ggx", "ff_hapke_slope", "mixture_lambertian_specular", "files", "deep",
+             "specular"]
+
+
+@pytest.mark.parametrize("template", TEMPLATES)
+def test_numeric_keys_load_or_are_refused_in_one_line_and_run_finite(scenes, template):
+    scene = scenes[template]
+    base = load_config(copy.deepcopy(scene))
+    assert not finite(oceanmc.simulate(base, threads=1))
+    problems = []
+    refused = ran = 0
+    for path, model, name in leaves(base):
+        indices = tuple(k for k in path[path.index(name) + 1:])
+        if (model.__name__, name, indices) in FUZZED:
+            continue
+        FUZZED.add((model.__name__, name, indices))
+        field = model.model_fields[name]
+        first_accepted = True
+        for value in sorted(set(VALUES) | bounds(field.annotation), key=repr):
+            if name in ("photons", "seed", "batches", "max_events", "phi_bands",
+                        "day_of_year") and math.isfinite(value) and value == int(value):
+                value = int(value)
+            where = (template, render(path), value)
+            try:
+                with warnings.catch_warnings():   # a warning would print lines of its own
+                    warnings.simplefilter("error", RuntimeWarning)
+                    config = load_config(with_value(scene, path, value))
+            except ConfigError as exc:
+                message = str(exc)
+                refused += 1
+                keys = [k for k in path if isinstance(k, str) and k not in ("water", "layers")]
+                if "\n" in message.strip() or not (
+                        any(k in message for k in keys) or any(s in message for s in shown(value))):
+                    problems.append((*where, "refused without naming the key or value",
+                                     message))
+                continue
+            except Exception as exc:   # noqa: BLE001 - any other exception is the failure
+                problems.append((*where, "traceback", repr(exc)))
+                continue
+            if template in COSTLY and not first_accepted:
+                continue
+            first_accepted = False
+            if name not in ("photons", "batches"):
+                config = config.model_copy(update=TINY_RUN)
+            if config.photons > 10_000:
+                continue
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", RuntimeWarning)
+                    result = oceanmc.simulate(config, threads=1)
+            except ConfigError as exc:
+                one_line(str(exc))
+                continue
+            except Exception as exc:   # noqa: BLE001
+                if where not in KNOWN:
+                    problems.append((*where, "traceback in the run", repr(exc)))
+                continue
+            ran += 1
+            bad = finite(result)
+            if bad and where not in KNOWN:
+                problems.append((*where, "non-finite results with success", bad[:4]))
+    assert not problems, "\n".join(map(str, problems))
+
+
+# --- the classes found, one test each -------------------------------------------------------
+
+def refused(config, *words):
+    with pytest.raises(ConfigError) as info:
+        load_config(config)
+    message = str(info.value)
+    one_line(message)
+    for word in words:
+        assert word in message, (word, message)
+    return message
+
+
+def test_mixture_components_b_is_bounded_as_a_layers_b():
+    """A mixture component's b had no upper bound: b = 1e308 ran (the layer's b, their sum,
+    escaped the layer's 0 .. 1e6 1/m) with overflows in the phase tables."""
+    petzold = {"model": "petzold"}
+    layer = {"thickness_m": 2.0, "a": 0.1, "phase": {"model": "mixture", "components": [
+        {"b": 1e308, "phase": petzold}]}}
+    refused(_mono(water={"layers": [layer]}), "water.layers[0].phase.components[0].b = 1e+308",
+            "less than or equal to 1000000")
+    layer["phase"]["components"] = [{"b": 1e6, "phase": petzold}, {"b": 1e6, "phase": petzold}]
+    refused(_mono(water={"layers": [layer]}), "water.layers[0]",
+            "their b add up to 2e+06 1/m", "allowed: at most 1e+06 1/m")
+
+
+def test_ed0_below_1e_minus_100_is_refused_its_variances_would_underflow(tmp_path):
+    """Ed0 = 1e-300 ran with every standard error 0 (the squared deviations of the batches fell
+    below the smallest double): refused below 1e-100, as is a spectrum that brings it there."""
+    for ed0 in (1e-101, 1e-300, 1e-308):
+        refused(_mono(illumination={"Ed0": ed0}), f"illumination.Ed0 = {ed0:g}",
+                "allowed: 1e-100 .. 1e+100")
+    result = oceanmc.simulate(_mono(illumination={"Ed0": 1e-100}, photons=400), threads=1)
+    assert np.all(result.stderr("Ed") > 0.0) and np.all(result.stderr("Lu") > 0.0)
+    (tmp_path / "s.csv").write_text("wavelength_nm,Ed0,diffuse_fraction\n400,1e-60,0.1\n"
+                                    "700,1,0.1\n")
+    config = load_config(_mono(wavelengths_nm=[400, 500], illumination={
+        "Ed0": 1e-50, "spectrum": {"model": "table", "file": str(tmp_path / "s.csv")}}))
+    with pytest.raises(ConfigError) as info:
+        oceanmc.simulate(config)
+    one_line(str(info.value))
+    assert "illumination.Ed0 = 1e-50 times the spectrum's Ed0 falls to 1e-110 at 400 nm; " \
+           "allowed: at least 1e-100" in str(info.value)
+
+
+def test_an_infinitely_deep_layer_over_a_bottom_is_refused_naming_its_thickness():
+    """thickness_m: .inf over a bottom was refused without naming thickness_m."""
+    layers = [{"thickness_m": 1.0, "a": 0.1, "b": 0.1}, {"thickness_m": math.inf, "a": 0.1,
+                                                          "b": 0.1}]
+    refused(_mono(water={"layers": layers}, tallies=SMALL_TALLIES),
+            "water.layers[1].thickness_m = .inf with bottom.model = 'lambertian'",
+            "use bottom.model = 'none' or a finite thickness_m")
+
+
+def test_photons_beyond_their_range_are_shown_as_written():
+    """photons: 1e308 was refused as '10000000000000000109790636294404554174049230967731184...'
+    (the 309 digits of int(1e308), cut): the value is now shown as given."""
+    for value, text in ((1e308, "photons = 1e+308"), ("1e308", "photons = '1e308'"),
+                        (-1e20, "photons = -1e+20")):
+        refused(_mono(photons=value), text, "allowed: 1 .. 1e+13")
+    assert load_config(_mono(photons="2e3")).photons == 2000
+
+
+def test_a_profile_needing_more_than_1e308_sublayers_is_refused_without_a_warning(capfd):
+    """Linear profile depths 1e-308 m apart over 5 m: numpy's 'overflow encountered in scalar
+    divide' (two lines on stderr) came before the one-line refusal, which counted 'inf
+    sublayers'."""
+    scene = _mono(wavelengths_nm=[400, 500], tallies=SMALL_TALLIES, water={"layers": [
+        {"thickness_m": 5.0, "components": [{"model": "pure_water"}, {
+            "model": "cdom", "a440": {"profile": "linear", "depths_m": [0, 1e-308, 5],
+                                      "values": [0.05, 0.06, 0.07]}}]}]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ConfigError) as info:
+            oceanmc.simulate(scene, threads=1)
+    one_line(str(info.value))
+    assert "its length scale of 1e-308 m" in str(info.value)
+    assert "needs more than 1e+308 sublayers; allowed: at most 5000" in str(info.value)
+
+
+# --- found here, outside the schema and the readers: strict xfail until fixed ------------------
+
+SPECTRAL_TURBID = {"photons": 200, "batches": 2, "seed": 1, "wavelengths_nm": [400, 550, 700],
+                   "water": {"layers": [{"thickness_m": math.inf, "a": [0.03, 0.06, 0.6],
+                                         "b": [10.0, 5.0, 2.0], "phase": {"model": "petzold"}}]},
+                   "bottom": {"model": "none"}, "tallies": {"depths_m": [0]}}
+
+
+@pytest.mark.xfail(strict=True, reason="kernel/spectral.py: a hero wavelength of large c and "
+                   "high albedo makes many collisions between settles; the other wavelengths' "
+                   "K_j shrink by c_j/c_h at each (no settle on shrinking, only past K_BOUND) "
+                   "while the deferred exp((c_h - c_j) D) grows: 0 x inf = NaN in settle")
+def test_spectral_walk_in_turbid_water_gives_finite_results():
+    """A turbid coastal water (b 10, 5, 2 1/m at 400, 550, 700 nm, a 0.03-0.6 1/m, Petzold) gave
+    NaN for every quantity with exit status 0 (`oceanmc run`, 20,000 photons, too)."""
+    assert not finite(oceanmc.simulate(SPECTRAL_TURBID, threads=1))
+
+
+@pytest.mark.xfail(strict=True, reason="kernel/spectral.py scatter_weights: beta_h = b_h p_h "
+                   "underflows for a subnormal b_h and 1 / beta overflows (NaN)")
+def test_spectral_layer_with_a_subnormal_b_at_one_wavelength_gives_finite_results():
+    scene = _mono(wavelengths_nm=[400, 500, 600], tallies=SMALL_TALLIES, estimator={},
+                  water={"layers": [{"thickness_m": 3.0, "a": [0.1, 0.2, 0.1],
+                                     "b": [1e-308, 0.2, 0.1]}]})
+    assert not finite(oceanmc.simulate(scene, threads=1))
+
+
+@pytest.mark.xfail(strict=True, raises=KeyError, reason="run/results.py: from_tallies leaves "
+                   "air/t_up out of a wavelength whose Eu(0-) is 0 in a batch, and "
+                   "stack_wavelengths then looks it up in every wavelength's Result")
+def test_spectral_scene_with_no_upwelling_light_at_one_wavelength_runs():
+    """Clear water (b = 0) over a bottom, absorbing 1000 1/m at one of two wavelengths: a
+    KeyError traceback ('air/t_up')."""
+    scene = _mono(wavelengths_nm=[400, 500], tallies={"depths_m": [0]}, estimator={},
+                  water={"layers": [{"thickness_m": 1.0, "a": [0.1, 1000.0], "b": 0.0}]})
+    assert not finite(oceanmc.simulate(scene, threads=1))
+
+
+@pytest.mark.xfail(strict=True, reason="run/results.py Quantity.stderr squares the deviations "
+                   "of the batches unscaled: below about 1e-154 they underflow to 0")
+def test_tiny_quantities_keep_their_standard_errors():
+    """A bottom of reflectance 1e-200 under non-scattering water: Eu ~ 1e-200 with a standard
+    error of exactly 0."""
+    scene = _mono(photons=2000, batches=4, tallies=SMALL_TALLIES, estimator={},
+                  water={"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 0.0}]},
+                  bottom={"model": "lambertian", "reflectance": 1e-200})
+    result = oceanmc.simulate(scene, threads=1)
+    assert np.all(result["Eu"] > 0.0)
+    assert np.all(result.stderr("Eu") > 0.0)
