@@ -61,6 +61,9 @@ _UNION_TAGS = _union_tags(SceneConfig)
 
 
 MAX_CONFIG_BYTES = 1 << 20  # a scene is a few KB; the limit stops /dev/zero and the like
+# a text table of MAX_TABLE_VALUES (scene/phase_tables.py) numbers would be about a gigabyte; no
+# table comes near this, and the bound keeps a mistaken file from filling the memory
+MAX_TABLE_BYTES = 1 << 28
 MAX_YAML_NODES = 100_000   # after aliases are expanded: stops "billion laughs" alias bombs
 
 
@@ -100,9 +103,29 @@ def _expanded_size(node: yaml.Node) -> int:
     return size(node)
 
 
-def _read_config_text(path: Path, origin: str) -> str:
-    """The file's text: a regular file of at most MAX_CONFIG_BYTES (a FIFO or a device would
-    block or never end)."""
+def file_problem(path: str | Path) -> str | None:
+    """Why `path` cannot be read as a data file (no such file, not a regular file: a folder, a
+    FIFO, a device; cannot read it), or None. Never raises (pathlib's is_file raises on a name
+    too long for the system)."""
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        return "no such file"
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        return f"cannot read it ({getattr(exc, 'strerror', None) or exc})"
+    return None if stat.S_ISREG(info.st_mode) else "not a regular file"
+
+
+def read_table_text(path: str | Path, origin: str) -> str:
+    """The text of a table file (read_text_file, at most MAX_TABLE_BYTES)."""
+    return read_text_file(path, origin, MAX_TABLE_BYTES, f"larger than {MAX_TABLE_BYTES >> 20} "
+                          "MB; allowed: a table file of at most that size")
+
+
+def read_text_file(path: str | Path, origin: str, limit: int, too_large: str) -> str:
+    """The UTF-8 text of a regular file of at most `limit` bytes (a FIFO or a device such as
+    /dev/zero would block or never end); every problem is a ConfigError starting with origin
+    (too_large ends the one for a larger file). Scene configs and the table files read it."""
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except FileNotFoundError:
@@ -114,15 +137,20 @@ def _read_config_text(path: Path, origin: str) -> str:
         os.close(fd)
         raise ConfigError(f"{origin}: not a regular file")
     with os.fdopen(fd, "rb") as file:
-        data = file.read(MAX_CONFIG_BYTES + 1)
-    if len(data) > MAX_CONFIG_BYTES:
-        raise ConfigError(f"{origin}: larger than {MAX_CONFIG_BYTES // 1024} KB; a scene "
-                          "config is a few KB of YAML")
+        data = file.read(limit + 1)
+    if len(data) > limit:
+        raise ConfigError(f"{origin}: {too_large}")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{origin}: not UTF-8 text ({exc.reason} at byte {exc.start})"
                           ) from None
+
+
+def _read_config_text(path: Path, origin: str) -> str:
+    """The file's text: a regular file of at most MAX_CONFIG_BYTES."""
+    return read_text_file(path, origin, MAX_CONFIG_BYTES, f"larger than "
+                          f"{MAX_CONFIG_BYTES // 1024} KB; a scene config is a few KB of YAML")
 
 
 def _parse_yaml(text: str, origin: str) -> Any:
@@ -268,51 +296,64 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
     return config
 
 
-def _file_fields(config: SceneConfig) -> list[tuple[object, str]]:
-    """(model, attribute) of every data file the scene names: phase, component, profile and
-    spectrum tables, the bottom's BRDF table, the sky map."""
-    fields: list[tuple[object, str]] = []
-    for layer in config.water.layers:
-        phases = [c.phase for c in layer.phase.components] \
-            if isinstance(layer.phase, Mixture) else [layer.phase]
-        for component in layer.components or ():
-            phases.append(getattr(component, "phase", None))
+def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
+    """(model, attribute, key path) of every data file the scene names: phase, component,
+    profile and spectrum tables, the bottom's BRDF table, the sky map."""
+    fields: list[tuple[object, str, str]] = []
+    for i, layer in enumerate(config.water.layers):
+        at = f"water.layers[{i}]"
+        phases = [(c.phase, f"{at}.phase.components[{k}].phase")
+                  for k, c in enumerate(layer.phase.components)] \
+            if isinstance(layer.phase, Mixture) else [(layer.phase, f"{at}.phase")]
+        for k, component in enumerate(layer.components or ()):
+            where = f"{at}.components[{k}]"
+            phases.append((getattr(component, "phase", None), f"{where}.phase"))
             if component.model == "table":
-                fields.append((component, "file"))
-            for value in component.__dict__.values():
+                fields.append((component, "file", f"{where}.file"))
+            for key, value in component.__dict__.items():
                 if getattr(value, "profile", None) == "table":
-                    fields.append((value, "file"))
-        fields += [(phase, "file") for phase in phases if isinstance(phase, TablePhase)]
+                    fields.append((value, "file", f"{where}.{key}.file"))
+        fields += [(phase, "file", f"{where}.file") for phase, where in phases
+                   if isinstance(phase, TablePhase)]
     if isinstance(config.bottom, TableBottom):
-        fields.append((config.bottom, "file"))
+        fields.append((config.bottom, "file", "bottom.file"))
     if config.illumination.spectrum.model == "table":
-        fields.append((config.illumination.spectrum, "file"))
+        fields.append((config.illumination.spectrum, "file", "illumination.spectrum.file"))
     if isinstance(config.illumination.sky, SkyMap):
-        fields.append((config.illumination.sky, "map"))
+        fields.append((config.illumination.sky, "map", "illumination.sky.map"))
     return fields
 
 
 def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
     """Table files are relative to the config file's folder; they are checked when the scene is
     built (oceanmc/scene.py), which reports the file and the problem."""
-    for model, attribute in _file_fields(config):
-        setattr(model, attribute, str((base_dir / getattr(model, attribute)).resolve()))
+    for model, attribute, key in _file_fields(config):
+        path = getattr(model, attribute)
+        try:
+            resolved = (base_dir / path).resolve()
+        except (OSError, RuntimeError) as exc:   # RuntimeError: a symlink loop (Python < 3.13)
+            raise ConfigError(f"{origin}: {key} = {path!r}: cannot resolve the path "
+                              f"({getattr(exc, 'strerror', None) or exc})") from None
+        setattr(model, attribute, str(resolved))
 
 
 def data_file_hashes(config: SceneConfig) -> str:
     """JSON {path: sha256 of its content} of every data file the scene names: the stored config
     holds only the paths, so merge and resume compare these to refuse an edited table."""
     hashes = {}
-    for model, attribute in _file_fields(config):
+    for model, attribute, _ in _file_fields(config):
         path = getattr(model, attribute)
         digest = hashlib.sha256()
-        try:
-            with open(path, "rb") as f:
+        try:   # not blocking on a FIFO, nor reading a device such as /dev/zero forever
+            with open(os.open(path, os.O_RDONLY | os.O_NONBLOCK), "rb") as f:
+                if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                    hashes[path] = "not a regular file"
+                    continue
                 while chunk := f.read(1 << 20):
                     digest.update(chunk)
             hashes[path] = digest.hexdigest()
-        except OSError as exc:   # the scene build reports it; this only records it
-            hashes[path] = f"unreadable ({exc.strerror})"
+        except (OSError, ValueError) as exc:   # the scene build reports it; this records it
+            hashes[path] = f"unreadable ({getattr(exc, 'strerror', None) or exc})"
     return json.dumps(hashes, sort_keys=True)
 
 

@@ -1,24 +1,36 @@
 """Spectral tables: the published ones shipped in oceanmc/data (each file's header cites its
-source) and users' CSVs, read once and interpolated linearly in wavelength. A wavelength outside a
-table's range is a ConfigError naming the key, the table and its range."""
+source) and users' CSVs, read once (again when the file changes) and interpolated linearly in
+wavelength. A wavelength outside a table's range is a ConfigError naming the key, the table and
+its range."""
 from __future__ import annotations
 
+import os
 from functools import lru_cache
 from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
 from ..config import ConfigError
+from ..config.loading import read_table_text
 
-
-@lru_cache(maxsize=None)
 def read_csv(path: str) -> dict[str, np.ndarray]:
-    """The columns of a CSV with '#' comment lines and one header line of column names."""
+    """The columns of a CSV with '#' comment lines and one header line of column names; parsed
+    again whenever the file changes (a table edited between two runs of one process is read
+    anew, as its recorded hash says)."""
     try:
-        lines = Path(path).read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read it ({exc})") from None
+        info = os.stat(path)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such file") from None
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{path}: cannot read it ({getattr(exc, 'strerror', None) or exc})"
+                          ) from None
+    return _parsed_csv(path, info.st_mtime_ns, info.st_size, info.st_ino)
+
+
+@lru_cache(maxsize=256)
+def _parsed_csv(path: str, mtime_ns: int, size: int, inode: int) -> dict[str, np.ndarray]:
+    """read_csv's table, remembered by the file's path, modification time, size and inode."""
+    lines = read_table_text(path, path).splitlines()
     rows = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
     if len(rows) < 2:
         raise ConfigError(f"{path}: needs a header line of column names and at least one row")
@@ -34,6 +46,7 @@ def read_csv(path: str) -> dict[str, np.ndarray]:
                           "separated by commas") from None
     if data.ndim != 2 or data.shape[1] != len(names):
         raise ConfigError(f"{path}: every row must have {len(names)} values ({', '.join(names)})")
+    data.flags.writeable = False   # the remembered table is shared by every reader
     return {name: data[:, k] for k, name in enumerate(names)}
 
 

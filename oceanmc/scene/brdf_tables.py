@@ -41,12 +41,16 @@ from .. import registry
 from ..config import ConfigError
 from ..kernel import models
 from ..kernel.brdf import tables as ktables
-from .phase_tables import (ARRAY_FILE_ERRORS, TableError, hdf5_arrays, npz_arrays,
+from ..config.loading import file_problem
+from .phase_tables import (ARRAY_FILE_ERRORS, TableError, hdf5_arrays, is_real, npz_arrays,
                            numeric_rows)
 
 ENERGY_TOLERANCE = 1e-3
 ANALYTIC_RECIPROCITY = 1e-6
 DEFENSIVE = 0.01          # share of the cosine-weighted density mixed into the sampler's cells
+# the largest value of a measured table: a glossy lobe of a milliradian reaches ~1e5 1/sr; with
+# bottom.allow_unphysical, values of 1e100 carried weights past 1e308 (NaN results)
+MAX_TABLE_BRDF = 1e6
 
 # (n_ti, n_pi, n_t, n_p) of the sampler grid
 ISOTROPIC_GRID = (46, 1, 45, 72)
@@ -112,7 +116,10 @@ def _axis(path, data: dict, name: str, lo: float, hi: float, minimum: int) -> np
     if name not in data:
         _fail(path, f"no array {name!r} (needed: theta_i_deg, theta_r_deg, phi_deg, brdf; "
                     "phi_i_deg for an anisotropic table)")
-    a = np.asarray(data[name], dtype=np.float64)
+    a = np.asarray(data[name])
+    if not is_real(a):
+        _fail(path, f"{name} is not real numbers ({a.dtype})")
+    a = a.astype(np.float64)
     if a.ndim != 1:
         _fail(path, f"{name} must be one-dimensional, got shape {a.shape}")
     if a.size < minimum:
@@ -132,8 +139,9 @@ def read_brdf_table(path) -> dict:
     """The measured BRDF in a file: a dict with theta_i, phi_i (None when isotropic), theta_r,
     phi (deg) and f, checked; every problem is a TableError naming the file."""
     path = Path(str(path))
-    if not path.is_file():
-        _fail(path, "no such file")
+    problem = file_problem(path)
+    if problem:
+        _fail(path, problem)
     if path.stat().st_size == 0:
         _fail(path, "is empty")
     data = _load_arrays(path)
@@ -143,8 +151,8 @@ def read_brdf_table(path) -> dict:
     f = np.asarray(data["brdf"])
     if f.size == 0:
         _fail(path, "the array 'brdf' is empty")
-    if not np.issubdtype(f.dtype, np.number):
-        _fail(path, f"the array 'brdf' is not numeric ({f.dtype})")
+    if not is_real(f):
+        _fail(path, f"the array 'brdf' is not real numbers ({f.dtype})")
     f = f.astype(np.float64)
     theta_i = _axis(path, data, "theta_i_deg", 0.0, 90.0, 2)
     theta_r = _axis(path, data, "theta_r_deg", 0.0, 90.0, 2)
@@ -163,6 +171,10 @@ def read_brdf_table(path) -> dict:
         k = np.argwhere(f < 0.0)[0]
         _fail(path, f"brdf has negative values ({f[tuple(k)]:g} at index "
                     f"{tuple(int(i) for i in k)}); a BRDF is non-negative")
+    if np.any(f > MAX_TABLE_BRDF):
+        k = np.argwhere(f > MAX_TABLE_BRDF)[0]
+        _fail(path, f"brdf = {f[tuple(k)]:g} at index {tuple(int(i) for i in k)}; allowed: "
+                    f"0 .. {MAX_TABLE_BRDF:g} (1/sr, or as a reflectance factor)")
     if not np.any(f > 0.0):
         _fail(path, "brdf is zero everywhere (use bottom.model: black)")
     if phi[0] != 0.0:

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config import ConfigError
+from ..config.loading import file_problem, read_table_text
 
 
 class TableError(ConfigError):
@@ -146,6 +147,12 @@ ARRAY_FILE_ERRORS = (OSError, ValueError, EOFError, TypeError, KeyError, zipfile
                      zlib.error)
 
 
+def is_real(a: np.ndarray) -> bool:
+    """Whether an array holds real numbers: integers or floats, not text, booleans, objects or
+    complex numbers (whose imaginary parts a conversion to float would drop)."""
+    return np.issubdtype(a.dtype, np.number) and not np.iscomplexobj(a)
+
+
 def bounded_npy(file, name: str) -> np.ndarray:
     """The array of an .npy stream, its header's shape checked against MAX_TABLE_VALUES first
     (a header may claim 10^10 values in a file of a few bytes)."""
@@ -194,10 +201,11 @@ def numeric_rows(path: Path, what: str) -> list[tuple[int, list[float]]]:
     '#' comments and blank lines skipped, one non-numeric header line allowed before the data.
     Problems are TableErrors that start with `what` and the file."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TableError(f"{what} {path}: cannot read it ({exc})") from None
+        text = read_table_text(path, f"{what} {path}")
+    except ConfigError as exc:
+        raise TableError(str(exc)) from None
     rows = []
+    header = False
     for lineno, line in enumerate(text.splitlines(), 1):
         line = line.strip()
         if not line or line.startswith("#"):
@@ -205,9 +213,10 @@ def numeric_rows(path: Path, what: str) -> list[tuple[int, list[float]]]:
         try:
             rows.append((lineno, [float(x) for x in line.replace(",", " ").split()]))
         except ValueError:
-            if rows:
+            if rows or header:   # a second header line would drop a bad first data row
                 raise TableError(f"{what} {path}, line {lineno}: not a number in "
                                  f"{line!r}") from None
+            header = True
     return rows
 
 
@@ -216,8 +225,9 @@ def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
     and phase value (>= 0, any scale). Comma or whitespace separated; lines starting with '#' and a
     non-numeric header line are skipped. Every problem is a TableError naming the file."""
     path = Path(str(path))
-    if not path.is_file():
-        raise TableError(f"phase table {path}: no such file")
+    problem = file_problem(path)
+    if problem:
+        raise TableError(f"phase table {path}: {problem}")
     rows = []
     for lineno, values in numeric_rows(path, "phase table"):
         if len(values) != 2:

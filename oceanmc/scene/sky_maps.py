@@ -71,7 +71,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .phase_tables import (ARRAY_FILE_ERRORS, TableError, bounded_npy, hdf5_arrays,
+from ..config.loading import file_problem
+from .phase_tables import (ARRAY_FILE_ERRORS, TableError, bounded_npy, hdf5_arrays, is_real,
                            npz_arrays)
 
 HC_GRID = (90, 180)       # Harrison-Coombes proposal cells: 1 deg in zenith, 2 deg in azimuth
@@ -199,8 +200,8 @@ def _read_exr(path, dataset: str, layout: str) -> np.ndarray:
 
 def _edges(path, data: dict, name: str, n: int, span: tuple[float, float] | None) -> np.ndarray:
     e = np.asarray(data[name])
-    if not np.issubdtype(e.dtype, np.number):
-        _fail(path, f"{name} is not numeric")
+    if not is_real(e):
+        _fail(path, f"{name} is not real numbers ({e.dtype})")
     e = e.astype(np.float64)
     if e.ndim != 1 or e.size != n + 1:
         _fail(path, f"{name} must be one-dimensional with {n + 1} values (one more than the "
@@ -224,8 +225,9 @@ def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
     """(theta_edges_deg, phi_edges_deg, radiance (n_theta, n_phi)) of a sky map file, checked;
     every problem is a TableError naming the file. layout: what an .exr image's rows cover."""
     path = Path(str(path))
-    if not path.is_file():
-        _fail(path, "no such file")
+    problem = file_problem(path)
+    if problem:
+        _fail(path, problem)
     if path.stat().st_size == 0:
         _fail(path, "is empty")
     suffix = path.suffix.lower()
@@ -255,7 +257,7 @@ def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
     L = np.asarray(data[dataset])
     if L.size == 0:
         _fail(path, f"the array {dataset!r} is empty")
-    if not np.issubdtype(L.dtype, np.number) or np.iscomplexobj(L):
+    if not is_real(L):
         _fail(path, f"the array {dataset!r} is not real numbers ({L.dtype})")
     if L.ndim != 2:
         _fail(path, f"the array {dataset!r} must be two-dimensional (theta_view rows x phi_view "
