@@ -142,6 +142,8 @@ KNOWN = {
     # exponentials overflow while the K_j underflow (0 x inf)
     ("lists_cox_munk_wind", "water.layers[0].b[0]", 1e6): "nan",
     ("lists_cox_munk_wind", "water.layers[0].b[2]", 1e6): "nan",
+    # the same with b 1375 .. 917 1/m (particles at b550 = 1000) over 400 .. 600 nm
+    ("constituents_minnaert", "water.layers[0].components[3].b550", 1000.0): "nan",
     # run/results.py: no upwelling light at 0- at one wavelength: air/t_up missing (KeyError)
     ("lists_cox_munk_wind", "water.layers[0].a[0]", 1e6): "KeyError",
     ("lists_cox_munk_wind", "water.layers[0].a[2]", 1e6): "KeyError",
@@ -209,20 +211,34 @@ def models_reached(obj, found=None) -> set:
     return found
 
 
-def bounds(annotation) -> set[float]:
-    """The values at the edges of the ranges an annotation allows (ge, le themselves; the
+def edges(constraints) -> set[float]:
+    """The values at the edges of the ranges the constraints allow (ge, le themselves; the
     next float inside gt, lt)."""
     out = set()
+    for constraint in constraints:
+        for kind, step in (("ge", None), ("le", None), ("gt", math.inf), ("lt", -math.inf)):
+            edge = getattr(constraint, kind, None)
+            if isinstance(edge, (int, float)) and math.isfinite(edge) and abs(edge) < 1e300:
+                out.add(float(edge) if step is None else math.nextafter(edge, step))
+    return out
+
+
+def bounds(annotation) -> set[float]:
+    """The range edges anywhere in an annotation (Annotated[..., Field(...)], in unions and
+    lists too)."""
+    out = set()
     for meta in getattr(annotation, "__metadata__", ()):
-        for constraint in [meta] + list(getattr(meta, "metadata", ())):
-            for kind, step in (("ge", None), ("le", None), ("gt", math.inf), ("lt", -math.inf)):
-                edge = getattr(constraint, kind, None)
-                if isinstance(edge, (int, float)) and math.isfinite(edge) and abs(edge) < 1e300:
-                    out.add(float(edge) if step is None else math.nextafter(edge, step))
+        out |= edges([meta] + list(getattr(meta, "metadata", ())))
     for arg in get_args(annotation):
         if not isinstance(arg, (str, int, float)):
             out |= bounds(arg)
     return out
+
+
+def field_bounds(field) -> set[float]:
+    """A field's range edges: pydantic keeps a plain Annotated field's constraints in its
+    metadata, not in its annotation."""
+    return edges(field.metadata) | bounds(field.annotation)
 
 
 def with_value(scene: dict, path: tuple, value) -> dict:
@@ -296,7 +312,7 @@ def test_numeric_keys_load_or_are_refused_in_one_line_and_run_finite(scenes, tem
         FUZZED.add((model.__name__, name, indices))
         field = model.model_fields[name]
         first_accepted = True
-        for value in sorted(set(VALUES) | bounds(field.annotation), key=repr):
+        for value in sorted(set(VALUES) | field_bounds(field), key=repr):
             if name in ("photons", "seed", "batches", "max_events", "phi_bands",
                         "day_of_year") and math.isfinite(value) and value == int(value):
                 value = int(value)
@@ -421,6 +437,35 @@ def test_a_profile_needing_more_than_1e308_sublayers_is_refused_without_a_warnin
     assert "needs more than 1e+308 sublayers; allowed: at most 5000" in str(info.value)
 
 
+@pytest.mark.parametrize("change, key", [
+    ({"water": {"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4, "phase": {
+        "model": "henyey_greenstein", "g": 1 - 1e-10}}]}}, "water.layers[0].phase.g"),
+    ({"water": {"layers": [{"thickness_m": 2.0, "a": 0.1, "b": 0.4, "phase": {
+        "model": "two_term_hg", "g1": 0.9, "g2": -1 + 1e-10}}]}}, "water.layers[0].phase.g2"),
+    ({"bottom": {"model": "hapke", "albedo": 0.5, "asymmetry": -1 + 1e-12}}, "bottom.asymmetry"),
+    ({"wavelengths_nm": [400, 600], "tallies": SMALL_TALLIES, "illumination": {
+        "spectrum": {"model": "spectrl2", "aerosol_asymmetry_factor": 1 - 1e-8}}},
+     "illumination.spectrum.aerosol_asymmetry_factor"),
+])
+def test_an_asymmetry_within_1e_minus_6_of_one_is_refused(change, key):
+    """Asymmetry parameters were allowed up to the float next to +-1: a Henyey-Greenstein g of
+    1 - 1e-10 gave NaN Lu, Lw_nadir and Rrs_nadir (the local estimate's cap tables) with exit 0,
+    a Hapke asymmetry of -1 + 1e-12 made the reciprocity check compare NaN (so it passed, with
+    numpy's warning printed), SPECTRL2's aerosol factor of 1 - 1e-8 gave NaN irradiances (and
+    pvlib's overflow warning). Allowed: -0.999999 .. 0.999999."""
+    scene = _mono(**change)
+    refused(scene, f"{key} = ", "allowed: -0.999999 .. 0.999999")
+    edge = copy.deepcopy(scene)
+    node = edge
+    parts = key.replace("[0]", ".0").split(".")
+    for part in parts[:-1]:
+        node = node[int(part)] if part.isdigit() else node[part]
+    node[parts[-1]] = math.copysign(0.999999, node[parts[-1]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert not finite(oceanmc.simulate(edge, threads=1))
+
+
 # --- found here, outside the schema and the readers: strict xfail until fixed ------------------
 
 SPECTRAL_TURBID = {"photons": 200, "batches": 2, "seed": 1, "wavelengths_nm": [400, 550, 700],
@@ -435,7 +480,8 @@ SPECTRAL_TURBID = {"photons": 200, "batches": 2, "seed": 1, "wavelengths_nm": [4
                    "while the deferred exp((c_h - c_j) D) grows: 0 x inf = NaN in settle")
 def test_spectral_walk_in_turbid_water_gives_finite_results():
     """A turbid coastal water (b 10, 5, 2 1/m at 400, 550, 700 nm, a 0.03-0.6 1/m, Petzold) gave
-    NaN for every quantity with exit status 0 (`oceanmc run`, 20,000 photons, too)."""
+    NaN for every quantity with exit status 0 (`oceanmc run`, 20,000 photons, too); so do
+    particles at b550 = 1000 1/m (KNOWN above)."""
     assert not finite(oceanmc.simulate(SPECTRAL_TURBID, threads=1))
 
 

@@ -5,7 +5,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field
 
-from .base import FilePath, Fraction, _Strict
+from .base import Asymmetry, FilePath, Fraction, _Strict
 
 
 class NoBottom(_Strict):
@@ -72,7 +72,7 @@ class HapkeBottom(_Strict):
     grains (negative: backward), opposition surge amplitude B0 and width h."""
     model: Literal["hapke"]
     albedo: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)]
-    asymmetry: Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False)] = 0.0
+    asymmetry: Asymmetry = 0.0
     opposition_amplitude: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 0.5
     opposition_width: Annotated[float, Field(gt=0.0, le=2.0, allow_inf_nan=False)] = 0.06
     allow_unphysical: bool = False

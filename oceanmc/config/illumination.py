@@ -6,7 +6,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 
-from .base import FilePath, Fraction, _Strict
+from .base import Asymmetry, FilePath, Fraction, _Strict
 
 # Ed(0+) in any units, bounded so that it times any tally (tallies hold up to ~1e6 x Ed0) and
 # the batches' variances stay finite, and from below so that they do not underflow (at Ed0 =
@@ -98,8 +98,7 @@ class Spectrl2Spectrum(_Strict):
     scattering_albedo_400nm: Fraction = 0.945
     alpha: Annotated[float, Field(ge=0.0, le=4.0, allow_inf_nan=False)] = 1.14
     wavelength_variation_factor: Fraction = 0.095
-    aerosol_asymmetry_factor: Annotated[float, Field(gt=-1.0, lt=1.0,
-                                                     allow_inf_nan=False)] = 0.65
+    aerosol_asymmetry_factor: Asymmetry = 0.65
     # else sun_position's day, else 4 April (Earth-Sun distance 1 AU)
     day_of_year: Annotated[int, Field(ge=1, le=366)] | None = None
 
