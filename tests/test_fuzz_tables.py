@@ -18,6 +18,8 @@ import pytest
 
 import oceanmc
 from oceanmc.config import ConfigError, data_file_hashes, load_config
+from oceanmc.optics.components.table import COLUMNS
+from oceanmc.optics.illumination import TABLE_COLUMNS
 
 VALUES = (math.nan, math.inf, -math.inf, 1e308, 1e-308, -1.0, 0.0)
 BASE = {"photons": 200, "batches": 2, "seed": 3,
@@ -88,8 +90,29 @@ def _text(header, rows):
                         for row in rows]) + "\n"
 
 
-def text_cases(header, rows):
+# the columns' allowed ranges (optics/tables.py read_table checks them): their edges are tried
+RANGES = {"component table": COLUMNS, "spectrum table": TABLE_COLUMNS,
+          "profile table": {"depth_m": (0.0, 1e6, "m"), "value": (0.0, 100.0, "mg/m3")}}
+# edge values whose run fails, or may, for a reason outside the readers (the strict xfail tests
+# of tests/test_fuzz_numeric_keys.py): b = 1e6 1/m at one wavelength, 0.1-0.2 at the others (the
+# spectral walk's NaN); a = 1e6 1/m at one wavelength (no upwelling light there: KeyError)
+KNOWN = {("component table", "edge b = 1000000.0 at row 0"),
+         ("component table", "edge b = 1000000.0 at row 2"),
+         ("component table", "edge a = 1000000.0 at row 0"),
+         ("component table", "edge a = 1000000.0 at row 2")}
+
+
+def text_cases(header, rows, ranges=None):
     """(label, file content: text, bytes, or None for a folder)."""
+    for c, (name, (low, high, _)) in enumerate((ranges or {}).items()):
+        for value in (low, high, math.nextafter(low, math.inf)):
+            for r in (0, len(rows) - 1):
+                changed = copy.deepcopy(rows)
+                changed[r][c] = value
+                firsts = [row[0] for row in changed]
+                if any(b <= a for a, b in zip(firsts, firsts[1:])):
+                    continue   # the first column stays increasing
+                yield f"edge {name} = {value!r} at row {r}", _text(header, changed)
     for value in VALUES:
         for r in sorted({0, len(rows) - 1}):
             for c in range(len(rows[0])):
@@ -190,7 +213,7 @@ def outcome(config: dict, path) -> str | None:
 def test_text_tables_are_accepted_and_run_finite_or_refused_in_one_line(kind, tmp_path):
     header, rows, place = TEXT_TABLES[kind]
     problems = []
-    for n, (label, content) in enumerate(text_cases(header, rows)):
+    for n, (label, content) in enumerate(text_cases(header, rows, RANGES.get(kind))):
         path = tmp_path / f"t{n}.csv"
         if content is None:
             path.mkdir()
@@ -199,7 +222,7 @@ def test_text_tables_are_accepted_and_run_finite_or_refused_in_one_line(kind, tm
         else:
             path.write_text(content, encoding="utf-8")
         wrong = outcome(place(str(path)), path)
-        if wrong:
+        if wrong and (kind, label) not in KNOWN:
             problems.append(f"{kind}, {label}: {wrong}")
     assert not problems, "\n".join(problems)
 
