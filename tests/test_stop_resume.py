@@ -30,6 +30,14 @@ def stop_after(polls):
     return should_stop
 
 
+def stopped_run(scene, monkeypatch, poll_s, polls):
+    """The scene run in the smallest calls, the main thread looking at should_stop every
+    poll_s seconds, and stopped after `polls` looks: a partial Result."""
+    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
+    monkeypatch.setattr(simulation, "POLL_SECONDS", poll_s)
+    return oceanmc.simulate(scene, threads=2, should_stop=stop_after(polls))
+
+
 def test_stopped_runs_resumed_are_bit_identical(tmp_path, small_scene, monkeypatch):
     """A run stopped three times, each partial file saved, loaded and resumed, against one
     uninterrupted run: every batch value equal bit for bit (different call lengths, different
@@ -62,9 +70,7 @@ def test_a_stop_before_any_batch_is_whole(small_scene, monkeypatch, tmp_path):
     from it gives the uninterrupted run."""
     small_scene.update(photons=20000, batches=2)
     full = oceanmc.simulate(small_scene, threads=2)
-    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
-    monkeypatch.setattr(simulation, "POLL_SECONDS", 0.001)
-    part = oceanmc.simulate(small_scene, threads=2, should_stop=stop_after(0))
+    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
     assert part.attrs["batches"] == 0 and part.attrs["partial"]
     assert np.isnan(part["Ed"]).all()
     part.save(tmp_path / "p.h5")
@@ -182,9 +188,7 @@ def test_spectral_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_scen
     another shape is refused."""
     small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 550.0, 650.0])
     full = oceanmc.simulate(small_scene, threads=2)
-    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
-    monkeypatch.setattr(simulation, "POLL_SECONDS", 0.001)
-    part = oceanmc.simulate(small_scene, threads=2, should_stop=stop_after(0))
+    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
     assert part.attrs["partial"] and part.resume_state is not None
     out = tmp_path / "p.h5"
     part.save(out)
@@ -208,9 +212,7 @@ def test_raw_tally_rows_of_an_earlier_oceanmc_are_refused(tmp_path, small_scene,
     without their tally_layout) cannot be continued: --resume refuses it in one line, exit
     status 2, and leaves it as it was; its whole batches stay readable."""
     small_scene.update(photons=60000, batches=6)
-    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.0)
-    monkeypatch.setattr(simulation, "POLL_SECONDS", 0.005)
-    part = oceanmc.simulate(small_scene, threads=2, should_stop=stop_after(2))
+    part = stopped_run(small_scene, monkeypatch, 0.005, 2)
     assert part.attrs["partial"] and part.resume_state is not None
     out = tmp_path / "p.h5"
     part.save(out)
