@@ -37,7 +37,14 @@ class Quantity:
         n = self.batches.shape[0]
         if n < 2:
             return np.full(self.batches.shape[1:], np.nan)
-        return self.batches.std(axis=0, ddof=1) / math.sqrt(n)
+        # the deviations are divided by their largest magnitude before they are squared:
+        # squared unscaled, deviations below about 1e-154 underflow to 0 (a standard error of
+        # exactly 0 for a tiny quantity) and those above about 1e154 overflow
+        deviations = self.batches - self.batches.mean(axis=0)
+        scale = np.abs(deviations).max(axis=0)
+        safe = np.where(scale > 0.0, scale, 1.0)
+        spread = np.sqrt(((deviations / safe) ** 2).sum(axis=0) / (n - 1))
+        return scale * spread / math.sqrt(n)
 
 
 @dataclass
@@ -71,6 +78,20 @@ class Result:
 
 
 # --- merging ------------------------------------------------------------------------------------
+
+# ratios from_tallies leaves out of a Result where their denominator is 0 in a batch (there is
+# no value to give: 0/0): air/t_up without upwelling light at 0-, air/rho_local without sky
+# light. The wavelengths of a spectral run, and runs of one scene, may differ in these only (a
+# batch of very absorbing water may have no upwelling photon where another has some)
+UNDEFINED_RATIOS = frozenset({"air/t_up", "air/rho_local"})
+
+
+def common_quantities(parts: list[Result]) -> set[str]:
+    """The quantities every part holds: a ratio of UNDEFINED_RATIOS that some part (a
+    wavelength of a spectral run, a run to merge) lacks is left out of the whole, as a run
+    leaves it out when one of its batches lacks it."""
+    return set.intersection(*(set(p.quantities) for p in parts))
+
 
 class MergeError(ValueError):
     """Results that cannot be combined; the message says why."""
@@ -195,12 +216,15 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
                             f"are in both result {j} and result {i + 1}: the same photons, not "
                             "independent ones")
                 ranges.append((seed, lo, hi, i + 1))
-        if set(first.quantities) != set().union(*(p.quantities for p in parts)):
-            raise MergeError("the results hold different quantities")
+    kept = common_quantities(parts)
+    differing = set().union(*(p.quantities for p in parts)) - kept
+    if differing - UNDEFINED_RATIOS:
+        raise MergeError(f"the results hold different quantities "
+                         f"({', '.join(sorted(differing - UNDEFINED_RATIOS))})")
     quantities = {
         name: Quantity(name, q.dims, np.concatenate([p.quantities[name].batches for p in parts]),
                        q.units, q.description)
-        for name, q in first.quantities.items()
+        for name, q in first.quantities.items() if name in kept
     }
     attrs = dict(first.attrs)
     for key in ("photons", "batches", "scattering_events"):
@@ -289,7 +313,8 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
         add("air/t_up", (), leaving[:, models.FLUX_EU] / flux[:, at_surface[0], models.FLUX_EU],
             "1", "upward transmittance of the surface for this run's upwelling light: "
-            "Eu_water_leaving(0+) / Eu(0-) (absent when a batch has no upwelling light)")
+            "Eu_water_leaving(0+) / Eu(0-) (absent when a batch, at any wavelength, has no "
+            "upwelling light)")
     if radiance:
         def per_quad(values):
             out = values * scale / omega
@@ -404,13 +429,15 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
 
 def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
     """One Result from the per-wavelength Results of a spectral run: every quantity gains a
-    leading `wavelength` dimension (nm; the coordinate `wavelength`), after the batch axis."""
+    leading `wavelength` dimension (nm; the coordinate `wavelength`), after the batch axis. A
+    ratio left out at some wavelength (UNDEFINED_RATIOS) is left out of the whole."""
     first = parts[0]
+    kept = common_quantities(parts)
     quantities = {
         name: Quantity(name, ("wavelength",) + q.dims,
                        np.stack([p.quantities[name].batches for p in parts], axis=1),
                        q.units, q.description)
-        for name, q in first.quantities.items()}
+        for name, q in first.quantities.items() if name in kept}
     coords = dict(first.coords, wavelength=np.asarray(wavelengths, dtype=np.float64))
     return Result(coords, quantities, dict(first.attrs))
 
