@@ -132,19 +132,10 @@ def templates(folder):
 COSTLY = {"ggx", "ff_hapke_slope", "files"}
 
 # accepted values whose run fails (NaN results or a traceback) for a reason outside the schema
-# and the readers: each is the subject of a strict xfail test below (when it is fixed, that test
-# passes and its entries here go)
-KNOWN = {
-    # kernel/spectral.py: a wavelength whose b is subnormal overflows 1 / beta_h (hero's)
-    ("lists_cox_munk_wind", "water.layers[0].b[0]", 1e-308): "nan",
-    ("lists_cox_munk_wind", "water.layers[0].b[2]", 1e-308): "nan",
-    # kernel/spectral.py: a wavelength scattering far more than the others: the deferred
-    # exponentials overflow while the K_j underflow (0 x inf)
-    ("lists_cox_munk_wind", "water.layers[0].b[0]", 1e6): "nan",
-    ("lists_cox_munk_wind", "water.layers[0].b[2]", 1e6): "nan",
-    # the same with b 1375 .. 917 1/m (particles at b550 = 1000) over 400 .. 600 nm
-    ("constituents_minnaert", "water.layers[0].components[3].b550", 1000.0): "nan",
-}
+# and the readers, each the subject of a strict xfail test (none left: the kernel's spectral
+# NaNs of b = 1e-308 or 1e6 at one wavelength and of particles at b550 = 1000 are fixed, tests
+# below)
+KNOWN: dict = {}
 
 
 # --- walking the schema -----------------------------------------------------------------------
@@ -471,24 +462,28 @@ SPECTRAL_TURBID = {"photons": 200, "batches": 2, "seed": 1, "wavelengths_nm": [4
                    "bottom": {"model": "none"}, "tallies": {"depths_m": [0]}}
 
 
-@pytest.mark.xfail(strict=True, reason="kernel/spectral.py: a hero wavelength of large c and "
-                   "high albedo makes many collisions between settles; the other wavelengths' "
-                   "K_j shrink by c_j/c_h at each (no settle on shrinking, only past K_BOUND) "
-                   "while the deferred exp((c_h - c_j) D) grows: 0 x inf = NaN in settle")
 def test_spectral_walk_in_turbid_water_gives_finite_results():
     """A turbid coastal water (b 10, 5, 2 1/m at 400, 550, 700 nm, a 0.03-0.6 1/m, Petzold) gave
-    NaN for every quantity with exit status 0 (`oceanmc run`, 20,000 photons, too); so do
-    particles at b550 = 1000 1/m (KNOWN above)."""
-    assert not finite(oceanmc.simulate(SPECTRAL_TURBID, threads=1))
+    NaN for every quantity with exit status 0: a hero of the largest c shrank every other K_j by
+    c_j / c_h per collision while the deferred exp((c_h - c_j) D) grew (0 x inf). Particles at
+    b550 = 1000 1/m and b = 1e6 1/m at one wavelength did the same (the numeric-key fuzz)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        result = oceanmc.simulate(SPECTRAL_TURBID, threads=1)
+    assert not finite(result)
+    assert np.all(result["Ed"] > 0.0)
 
 
-@pytest.mark.xfail(strict=True, reason="kernel/spectral.py scatter_weights: beta_h = b_h p_h "
-                   "underflows for a subnormal b_h and 1 / beta overflows (NaN)")
-def test_spectral_layer_with_a_subnormal_b_at_one_wavelength_gives_finite_results():
+def test_spectral_layer_with_a_subnormal_b_at_one_wavelength_is_refused():
+    """b = 1e-308 1/m at one wavelength and 0.2 at another overflowed 1 / beta_h (NaN with exit
+    status 0): the spectral walk's ratios of scattering need b within 12 orders of magnitude."""
     scene = _mono(wavelengths_nm=[400, 500, 600], tallies=SMALL_TALLIES, estimator={},
                   water={"layers": [{"thickness_m": 3.0, "a": [0.1, 0.2, 0.1],
                                      "b": [1e-308, 0.2, 0.1]}]})
-    assert not finite(oceanmc.simulate(scene, threads=1))
+    with pytest.raises(ConfigError) as info:
+        oceanmc.simulate(scene, threads=1)
+    one_line(str(info.value))
+    assert "water.layers[0].b" in str(info.value) and "400 nm" in str(info.value)
 
 
 def test_spectral_scene_with_no_upwelling_light_at_one_wavelength_runs():

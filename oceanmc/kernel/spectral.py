@@ -28,6 +28,8 @@ surface's, the albedos, roulette) and, per wavelength, K_j (R_j) and G_j:
   D) of both is applied when the packet settles (settle): on every plane (layer boundaries,
   tally depths, surface, bottom), before any score, and when a K_j grows past a bound. So a
   collision costs a few products per wavelength, and a settle one exponential per wavelength.
+  A settle also comes when a K_j shrinks below 1 / K_BOUND, or when D is so long that a
+  deferred exponential would leave exp(+-DEFERRED_EXPONENT_BOUND) (turbid water).
 - p.w follows the reference wavelength r (p.reference: the heaviest at the last roulette test):
   a collision gives p.w the factor beta_r / beta_h and G_j beta_j / beta_r, a free path gives
   p.w exp(-(c_r - c_h) s) at once (fly), and a settle scales G to G_r = 1. So roulette, tested
@@ -71,9 +73,16 @@ from .rng import uniform
 from .packet import free_path_at, weights
 from .tally import spectral_at
 
-# a K_j past this settles the packet (its exponentials bring the K back near 1), long before
-# products of ratios could overflow
+# a K_j past this, or positive below its inverse, settles the packet (its exponentials bring
+# the K back near 1), long before products of ratios could overflow or underflow; a K_j still
+# below the inverse after a settle is 0 (its walk's density is nothing beside the others': in
+# a turbid layer a hero of the largest c shrinks every other K_j by c_j / c_h per collision
+# while the deferred exp((c_h - c_j) D) grows, 0 x inf = NaN without these bounds)
 K_BOUND = 1e100
+K_FLOOR = 1.0 / K_BOUND
+# a packet whose deferred path D would make some exp(-(c_j - c_h) D) leave exp(+-this) settles
+# (MEDIUM layer_settle_path, scene/medium.py): the exponentials of a settle stay finite
+DEFERRED_EXPONENT_BOUND = 300.0
 
 
 @kernel
@@ -148,7 +157,8 @@ def settle(medium, floats, grid, tally, ps, p, layer):
     w = p.w
     absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(n):
-        k[j] *= norm
+        k_j = k[j] * norm
+        k[j] = k_j if k_j >= K_FLOOR else 0.0
         g[j] *= g_norm
         now = w * g[j]
         tally[absorbed + j] += last[j] - now
@@ -291,7 +301,7 @@ def scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s
             g[j] *= beta[j] * per_ref
             k_j = k[j] * (beta[j] * per_k)
             k[j] = k_j
-            over += k_j > K_BOUND
+            over += (k_j > K_BOUND) | ((k_j < K_FLOOR) & (k_j > 0.0))
     elif keep == 1.0:
         per_ref = 1.0 / beta[r]
         per_k = 1.0 / (beta[h] * c_over_b[h])
@@ -300,7 +310,7 @@ def scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s
             g[j] *= beta[j] * per_ref
             k_j = k[j] * (beta[j] * c_over_b[j] * per_k)
             k[j] = k_j
-            over += k_j > K_BOUND
+            over += (k_j > K_BOUND) | ((k_j < K_FLOOR) & (k_j > 0.0))
     else:
         if beta[r] <= 0.0:   # a direction from the cone that the hero's phase function lacks
             for j in range(n):
@@ -319,8 +329,8 @@ def scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s
             g[j] *= beta[j] * per_ref
             k_j = k[j] * ((keep * beta[j] * c_over_b[j] + s_d * c[j]) * per_k)
             k[j] = k_j
-            over += k_j > K_BOUND
-    if over > 0:
+            over += (k_j > K_BOUND) | ((k_j < K_FLOOR) & (k_j > 0.0))
+    if over > 0 or ps[free_path_at(grid)] > floats[medium.layer_settle_path + layer]:
         settle(medium, floats, grid, tally, ps, p, layer)
 
 

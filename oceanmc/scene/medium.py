@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import config as cfg
 from .. import optics, registry
-from ..kernel import models
+from ..kernel import models, spectral
 from ..kernel.records import MEDIUM, Pool, record
 from . import phase_tables
 
@@ -92,12 +92,25 @@ def optical_depths(plane_z: np.ndarray, segment_layer: np.ndarray, c: np.ndarray
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
+# the spectral walk's smallest b at one wavelength relative to the layer's largest
+B_SPREAD_LIMIT = 1e-12
+
+
 def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
     """Scattering biased toward straight up (kernel/upward.py): a layer's fraction is at most
     1 - w0, so that no scattering event makes a packet heavier; 0 in a layer leaves it out."""
     fraction = np.minimum(float(estimator.upward_fraction or 0.0), 1.0 - albedo)
     fraction[albedo <= 0.0] = 0.0
     return fraction
+
+
+def settle_paths(layer_c: np.ndarray) -> np.ndarray:
+    """Per layer, the free path after which a spectral packet settles whatever its K
+    (kernel/spectral.py): the deferred factors exp(-(c_j - c_h) D) stay within
+    exp(+-DEFERRED_EXPONENT_BOUND) of 1; inf in a layer of one c at every wavelength."""
+    spread = layer_c.max(axis=1) - layer_c.min(axis=1)
+    return np.divide(spectral.DEFERRED_EXPONENT_BOUND, spread, out=np.full(len(spread), np.inf),
+                     where=spread > 0.0)
 
 
 def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> None:
@@ -109,6 +122,13 @@ def _spectral_checks(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) ->
                 f"water.layers[{layer.config_layer}].b is 0 at some wavelengths and not at "
                 "others: the spectral walk needs a layer to scatter at every wavelength or at "
                 "none (give a small b > 0)")
+        if scatters.any() and layer.b.min() < B_SPREAD_LIMIT * layer.b.max():
+            raise cfg.ConfigError(
+                f"water.layers[{layer.config_layer}].b is {layer.b.min():.3g} 1/m at "
+                f"{config.wavelengths[int(np.argmin(layer.b))]:g} nm and "
+                f"{layer.b.max():.3g} 1/m at another wavelength: the spectral walk needs b "
+                f"within a factor {1 / B_SPREAD_LIMIT:.0e} of its largest value at every "
+                "wavelength (its ratios of scattering would overflow)")
 
 
 def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[int],
@@ -240,6 +260,7 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         layer_albedo=f.add(albedo_all),
         layer_c_over_b=f.add(np.divide(layer_c, layer_b, out=np.zeros_like(layer_c),
                                        where=layer_b > 0.0)),
+        layer_settle_path=f.add(settle_paths(layer_c)),
         up_fraction=f.add(fraction),
         up_density=f.add(fraction / up_solid_angle),
         up_keep=f.add(1.0 - fraction), comp_cumweight=f.add(cumweight),
