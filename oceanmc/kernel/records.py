@@ -51,11 +51,11 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 # `wavelength`, the hero wavelength of a spectral walk, kernel/spectral.py, which reads a
 # layer's wavelengths in a row).
 #   float pool: plane_z (n_planes), plane_tau (n_wl x n_planes); layer_c, layer_inv_c,
-#               layer_albedo, layer_c_over_b (n_layers x n_wl); layer_settle_path, up_fraction,
-#               up_density, up_keep (n_layers); comp_cumweight (n_wl x n_comps; cumulative within each
-#               layer), comp_params (2 each); tab_psi (each distinct angle grid once, at a
-#               component's psi_start), tab_q, tab_cdf (each table at its component's
-#               tab_start); mix_coef; channel_b (n_layers x n_channels x n_wl: each collision
+#               layer_albedo, layer_c_over_b (n_layers x n_wl); layer_settle_path,
+#               up_fraction, up_density, up_keep (n_layers); comp_cumweight (n_wl x n_comps;
+#               cumulative within each layer), comp_params (2 each); tab_psi (each distinct
+#               angle grid once, at a component's psi_start), tab_q, tab_cdf (each table at
+#               its component's tab_start); mix_coef; channel_b (n_layers x n_channels x n_wl: each collision
 #               channel's scattering coefficient, adding up to the layer's b; kernel/channels/)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
@@ -69,7 +69,8 @@ MEDIUM = _record(
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),
     floats_at=("plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
                "layer_c_over_b", "layer_settle_path", "up_fraction", "up_density", "up_keep",
-               "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef", "channel_b"),
+               "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
+               "channel_b"),
     ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
              "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
              "mix_comp", "mix_at", "channel_model"))
