@@ -261,13 +261,15 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    from .config.loading import file_problem
     from .run.compiling import CompileInterrupted
     from .sweeps import OutputExists, SweepError, sweep
 
     source = Path(args.sweep)
     out = Path(args.output) if args.output else Path("results") / f"{source.stem}.nc"
-    if not source.is_file():
-        raise UsageError(f"{source}: no such file")
+    problem = file_problem(source)   # a FIFO or a device is "not a regular file", not missing
+    if problem:
+        raise UsageError(f"{source}: {problem}")
     if out.suffix != ".nc":
         raise UsageError(f"-o {out}: a sweep writes a NetCDF file; name it *.nc")
     _check_writable(out, overwrite=True)   # what the sweep may replace: sweep() judges it

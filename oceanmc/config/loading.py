@@ -147,13 +147,18 @@ def read_text_file(path: str | Path, origin: str, limit: int, too_large: str) ->
                           ) from None
 
 
-def _read_config_text(path: Path, origin: str) -> str:
-    """The file's text: a regular file of at most MAX_CONFIG_BYTES."""
-    return read_text_file(path, origin, MAX_CONFIG_BYTES, f"larger than "
-                          f"{MAX_CONFIG_BYTES // 1024} KB; a scene config is a few KB of YAML")
+def read_yaml_file(path: str | Path, origin: str, kind: str = "scene") -> Any:
+    """The YAML document in a file, read with the guards of a scene config: a regular file (a
+    FIFO would block, /dev/zero never end) of at most MAX_CONFIG_BYTES, UTF-8, no key given
+    twice, aliases expanding to at most MAX_YAML_NODES values. Every problem is one
+    ConfigError starting with origin; `kind` (scene, sweep) names what the file should be.
+    Scene configs and sweep files (sweeps/axes.py) read it."""
+    text = read_text_file(path, origin, MAX_CONFIG_BYTES, f"larger than "
+                          f"{MAX_CONFIG_BYTES // 1024} KB; a {kind} file is a few KB of YAML")
+    return _parse_yaml(text, origin, kind)
 
 
-def _parse_yaml(text: str, origin: str) -> Any:
+def _parse_yaml(text: str, origin: str, kind: str = "scene") -> Any:
     try:
         loader = _SceneLoader(text)
         try:
@@ -162,7 +167,7 @@ def _parse_yaml(text: str, origin: str) -> Any:
                 return None
             if _expanded_size(node) > MAX_YAML_NODES:
                 raise ConfigError(f"{origin}: its aliases expand to more than "
-                                  f"{MAX_YAML_NODES:,} values; a scene needs a few dozen")
+                                  f"{MAX_YAML_NODES:,} values; a {kind} needs far fewer")
             return loader.construct_document(node)
         finally:
             loader.dispose()
@@ -174,7 +179,7 @@ def _parse_yaml(text: str, origin: str) -> Any:
     except yaml.YAMLError as exc:
         raise ConfigError(f"{origin}: not valid YAML: {str(exc).splitlines()[0]}") from None
     except RecursionError:
-        raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
+        raise ConfigError(f"{origin}: nested too deeply to be a {kind}") from None
 
 
 def _key_path(loc: tuple) -> str:
@@ -260,7 +265,7 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
     if isinstance(source, (str, Path)):
         path = Path(source)
         origin = str(path)
-        data = _parse_yaml(_read_config_text(path, origin), origin)
+        data = read_yaml_file(path, origin)
         base_dir = path.parent
     elif isinstance(source, dict):
         data = source

@@ -220,7 +220,7 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     SceneConfig."""
     if isinstance(source, (str, Path)):
         path = Path(source)
-        data = _read_yaml(path, str(path))
+        data = _read_yaml(path, str(path), "sweep")
         folder = path.parent
     else:
         data, folder = source, Path.cwd()
@@ -244,15 +244,15 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     return SweepSpec(base, base_dir, dict(settings), axes, groups)
 
 
-def _read_yaml(path: Path, what: str) -> Any:
-    """The YAML document in path; `what` names it in the one-line error."""
+def _read_yaml(path: Path, what: str, kind: str) -> Any:
+    """The YAML document in path, read with the scene loader's guards (a key given twice, a
+    FIFO or a device, a file over 1 MB, an alias bomb: each refused in one line); `what` names
+    it in the one-line error, `kind` (sweep, scene) says what it should be."""
+    from ..config.loading import read_yaml_file
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SweepError(f"{what}: no such file ({path})") from None
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise SweepError(f"{what}: cannot read it as YAML "
-                         f"({str(exc).splitlines()[0]})") from None
+        return read_yaml_file(path, what, kind)
+    except ConfigError as exc:   # a SweepError, which `oceanmc sweep` reports (exit status 2)
+        raise SweepError(str(exc)) from None
 
 
 def _base_scene(base: Any, folder: Path) -> tuple[dict, Path]:
@@ -263,7 +263,9 @@ def _base_scene(base: Any, folder: Path) -> tuple[dict, Path]:
         return base.model_dump(), folder
     if isinstance(base, (str, Path)):
         path = Path(base) if Path(base).is_absolute() else folder / base
-        scene = _read_yaml(path, f"base = {str(base)!r}")
+        # a relative base is relative to the sweep file's folder: the message says where
+        where = "" if str(path) == str(base) else f" ({path})"
+        scene = _read_yaml(path, f"base = {str(base)!r}{where}", "scene")
         if not isinstance(scene, dict):
             raise SweepError(f"base = {str(base)!r}: not a scene (a mapping of keys)")
         return scene, path.parent
