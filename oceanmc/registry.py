@@ -35,6 +35,7 @@ PHASE = {
 CONSTITUENT = {
     "pure_water": "pure_water",
     "chlorophyll": "chlorophyll",
+    "case1": "case1",
     "cdom": "cdom",
     "particles": "particles",
     "table": "table",

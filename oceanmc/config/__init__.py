@@ -12,9 +12,9 @@ from .base import Asymmetry, ConfigError, Finite, Fraction, NonNegative, _Strict
 from .bottom import (BlackBottom, Bottom, GGXBottom, HapkeBottom, LambertianBottom,
                      LambertianSpecularBottom, MinnaertBottom, NoBottom, Sampling, SpecularBottom,
                      TableBottom, bottom_has_mirror, bottom_weight_bounded)
-from .components import (CdomComponent, ChlorophyllComponent, Component, ConstantComponent,
-                         GaussianProfile, LinearProfile, ParticlesComponent, Profile,
-                         PureWaterComponent, TableComponent, TableProfile)
+from .components import (Case1Component, CdomComponent, ChlorophyllComponent, Component,
+                         ConstantComponent, GaussianProfile, LinearProfile, ParticlesComponent,
+                         Profile, PureWaterComponent, TableComponent, TableProfile)
 from .estimator import Estimator
 from .illumination import (FlatSpectrum, Illumination, SkyMap, Spectrl2Spectrum, Spectrum,
                            SunPosition, TableSpectrum)
@@ -34,8 +34,8 @@ __all__ = [
     "Petzold", "TablePhase", "BasicPhase", "MixtureComponent", "Mixture", "Phase",
     "Layer", "Water", "WavelengthRange",
     "GaussianProfile", "LinearProfile", "TableProfile", "Profile", "PureWaterComponent",
-    "ChlorophyllComponent", "CdomComponent", "ParticlesComponent", "TableComponent",
-    "ConstantComponent", "Component",
+    "ChlorophyllComponent", "Case1Component", "CdomComponent", "ParticlesComponent",
+    "TableComponent", "ConstantComponent", "Component",
     "SkyMap", "Illumination", "SunPosition", "FlatSpectrum", "Spectrl2Spectrum", "TableSpectrum",
     "Spectrum",
     "Surface",

@@ -109,6 +109,16 @@ class ChlorophyllComponent(_Strict):
     chl_mg_m3: amount(MAX_CHL_MG_M3, "mg/m3")
 
 
+class Case1Component(_Strict):
+    """Case-1 water's every non-water IOP from chlorophyll alone, HydroLight's "new Case 1" model
+    (optics/components/case1.py): particles (phytoplankton and covarying detritus) a_p = A_p
+    Chl^E_p (Bricaud et al. 1998), CDOM 0.2 a_p(440) exp(-0.014 (lambda - 440)), b_p = 0.416
+    Chl^0.766 (lambda/550)^nu and two particle populations with the bb/b of Morel et al. (2002).
+    Pure water is its own component."""
+    model: Literal["case1"]
+    chl_mg_m3: amount(MAX_CHL_MG_M3, "mg/m3")
+
+
 class CdomComponent(_Strict):
     """Coloured dissolved organic matter: a_g = a440 exp(-slope (lambda - 440)); no scattering."""
     model: Literal["cdom"]
@@ -156,11 +166,12 @@ class ConstantComponent(_Strict):
 
 
 Component = Annotated[
-    Union[PureWaterComponent, ChlorophyllComponent, CdomComponent, ParticlesComponent,
-          TableComponent, ConstantComponent],
+    Union[PureWaterComponent, ChlorophyllComponent, Case1Component, CdomComponent,
+          ParticlesComponent, TableComponent, ConstantComponent],
     Field(discriminator="model"),
 ]
 
 # the keys of each model whose value may be a depth profile
-PROFILE_KEYS = {"pure_water": (), "chlorophyll": ("chl_mg_m3",), "cdom": ("a440",),
+PROFILE_KEYS = {"pure_water": (), "chlorophyll": ("chl_mg_m3",), "case1": ("chl_mg_m3",),
+                "cdom": ("a440",),
                 "particles": ("concentration",), "table": (), "constant": ("concentration",)}

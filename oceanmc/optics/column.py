@@ -9,9 +9,9 @@ by the sublayer's c moves the optical depth from the sublayer's top to any depth
 most OPTICAL_DEPTH_TOLERANCE, at every wavelength (the integral of the difference by the
 trapezoidal rule on 9 depths per sublayer; sublayers are also cut at the profile's nodes). At
 sublayer boundaries the optical depth is exact for constituents linear in their amount (cdom,
-particles, constant) and within the tolerance for chlorophyll, so the error never accumulates
-beyond one sublayer's for them. tests/test_optics_profiles.py checks the bound against a
-finer layering."""
+particles, constant) and within the tolerance for chlorophyll and case1, so the error never
+accumulates beyond one sublayer's for them. tests/test_optics_profiles.py checks the bound
+against a finer layering."""
 from __future__ import annotations
 
 import math
