@@ -237,3 +237,32 @@ def test_a_sweep_or_base_that_is_a_fifo_or_a_device_exits_2_in_one_line(tmp_path
     code, err = cli("sweep", "fifo.yaml", "-o", "lut.nc", "--workers", "1", "-q")
     assert (code, err) == (2, "oceanmc: error: fifo.yaml: not a regular file\n")
     assert not (tmp_path / "lut.nc").exists() and not (tmp_path / "lut.points").exists()
+
+
+def test_more_than_100000_points_are_refused_before_any_is_built(monkeypatch):
+    """{linspace: [0, 1, 10000000]} was validated for more than 10 minutes before anything ran
+    (and numpy made its grid first): at most 100,000 points per generator and in all, refused
+    in one line before a point is built."""
+    import time
+    from oceanmc.sweeps import axes
+
+    def no_grid(*args):
+        raise AssertionError("the grid was made")
+    monkeypatch.setattr(axes.np, "linspace", no_grid)
+    start = time.perf_counter()
+    assert points_or_one_line(
+        {"base": TINY, "axes": {"water.layers[0].a": {"linspace": [0, 1, 10**7]}}},
+        "axes: water.layers[0].a.linspace = [0, 1, 10000000]: 10,000,000 points; allowed: at "
+        "most 100,000 points in a sweep")
+    monkeypatch.undo()
+    grid = {"linspace": [0.1, 1, 400]}
+    assert points_or_one_line(
+        {"base": TINY, "axes": {"water.layers[0].a": grid, "bottom.reflectance": grid}},
+        "axes: 400 (water.layers[0].a) x 400 (bottom.reflectance) = 160,000 points; allowed: at "
+        "most 100,000 points in a sweep (split it into several sweeps)")
+    assert points_or_one_line(
+        {"base": TINY, "axes": {"water.layers[0].a": list(range(1, 100_002))}},
+        "axes: 100,001 (water.layers[0].a) points; allowed: at most 100,000")
+    assert time.perf_counter() - start < 5.0
+    assert len(load_sweep({"base": TINY, "axes": {"water.layers[0].a": {"linspace": [
+        0.1, 1, 250]}, "bottom.reflectance": {"linspace": [0, 1, 400]}}}).axes) == 2

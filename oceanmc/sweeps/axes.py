@@ -32,6 +32,10 @@ _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d+\])*)$")
 _INDEX = re.compile(r"\[(-?\d+)\]")
 SWEEP_KEYS = ("base", "set", "axes", "batch_groups")
 GENERATORS = ("linspace", "geomspace")
+# every point's scene is validated (about 1-2 ms each) before anything runs, and each becomes a
+# results file and a task: 100,000 points take minutes to check and are far more than a look-up
+# table needs; {linspace: [0, 1, 10000000]} was validated for more than 10 minutes unbounded
+MAX_POINTS = 100_000
 
 
 class SweepError(ConfigError):
@@ -237,6 +241,12 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     for key in settings:
         parse_key_path(key)
     axes = _axes(data.get("axes"))
+    total = math.prod(len(axis) for axis in axes)
+    if total > MAX_POINTS:   # before any point is built
+        sizes = " x ".join(f"{len(axis):,} ({axis.dim})" for axis in axes)
+        raise SweepError(f"axes: {sizes}{f' = {total:,}' if len(axes) > 1 else ''} points; "
+                         f"allowed: at most {MAX_POINTS:,} points in a sweep (split it into "
+                         "several sweeps)")
     groups = data.get("batch_groups", 1)
     if isinstance(groups, bool) or not isinstance(groups, int) or groups < 1:
         raise SweepError(f"batch_groups = {groups!r}: expected an integer >= 1 (the number of "
@@ -370,6 +380,9 @@ def _values(key: str, values: Any) -> tuple[Any, ...]:
                 and all(math.isfinite(a) for a in args)):
             raise SweepError(f"axes: {key}.{kind} = {args!r}: expected [start, stop, num] with "
                              "finite numbers and an integer num >= 1")
+        if args[2] > MAX_POINTS:   # before numpy makes the grid
+            raise SweepError(f"axes: {key}.{kind} = {args!r}: {args[2]:,} points; allowed: at "
+                             f"most {MAX_POINTS:,} points in a sweep")
         if kind == "geomspace" and args[0] * args[1] <= 0:
             raise SweepError(f"axes: {key}.geomspace = {args!r}: start and stop must be "
                              "non-zero and of the same sign")
