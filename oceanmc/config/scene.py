@@ -10,7 +10,7 @@ from .base import _Strict
 from .bottom import Bottom, bottom_has_mirror, bottom_weight_bounded
 from .estimator import Estimator
 from .illumination import Illumination
-from .surface import Surface
+from .surface import MAX_CAP_MSS, Surface
 from .tallies import Tallies
 from .water import Water
 from .wavelengths import Wavelengths, check_increasing, grid
@@ -91,10 +91,16 @@ class SceneConfig(_Strict):
             raise ValueError(f"tallies.nadir_estimator = 'local' with bottom.model = "
                              f"{self.bottom.model!r}: a mirror has no density for a local "
                              "estimate; use 'crossing' or 'auto'")
-        if self.tallies.nadir_estimator == "local" and self.surface.model == "cox_munk":
-            raise ValueError("tallies.nadir_estimator = 'local' with surface.model = "
-                             "'cox_munk': the polar-cap tables assume a flat surface; use "
-                             "'crossing' or 'auto', or local_directions_deg: [[180, 0]]")
+        if self.tallies.nadir_estimator == "local" and not self.surface.cap_lobe_tabulated():
+            upwind, crosswind = self.surface.slope_variances()
+            raise ValueError(
+                "tallies.nadir_estimator = 'local' with surface.model = 'cox_munk' of "
+                + (f"mean square slope {upwind + crosswind:g}" if upwind == crosswind else
+                   f"wind_direction_deg = {self.surface.wind_direction_deg} (anisotropic "
+                   "slopes)")
+                + ": the polar-cap tables through waves need isotropic slopes of mean square "
+                f"slope at most {MAX_CAP_MSS} (wind_speed_m_s without wind_direction_deg); use "
+                "'crossing' or 'auto'")
         if self.tallies.local_directions_deg and bottom_has_mirror(self.bottom):
             raise ValueError(f"tallies.local_directions_deg with bottom.model = "
                              f"{self.bottom.model!r}: a mirror has no density for a local "

@@ -12,6 +12,9 @@ from .base import _Strict
 CM_MSS = (0.003, 5.12e-3)
 CM_UPWIND = (0.0, 3.16e-3)
 CM_CROSSWIND = (0.003, 1.92e-3)
+# the largest mean square slope through which the nadir cap's local estimate is tabulated
+# (kernel/rough_cap.py; 30 m/s gives 0.157)
+MAX_CAP_MSS = 0.2
 
 
 class Surface(_Strict):
@@ -19,7 +22,11 @@ class Surface(_Strict):
     cox_munk: the wind-roughened sea, Gaussian facet slopes (Cox & Munk 1954) from
     wind_speed_m_s (isotropic, or upwind/crosswind with wind_direction_deg: the azimuth the
     wind blows toward, from the sun's rays' azimuth) or from mean_square_slope.
-    fresnel: schlick swaps in Schlick's approximation, for comparisons only (never exact)."""
+    fresnel: schlick swaps in Schlick's approximation, for comparisons only (never exact).
+    method (cox_munk): table samples a table of the facet walk's BSDF, built once per (slopes,
+    n_water) and cached on disk (scene/surface_table.py; isotropic slopes only); walk follows
+    every photon facet by facet (the reference, several times slower). Default: table, or walk
+    when wind_direction_deg makes the slopes anisotropic."""
     model: Literal["flat", "none", "cox_munk"] = "flat"
     n_water: Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.34
     fresnel: Literal["exact", "schlick"] = "exact"
@@ -28,15 +35,17 @@ class Surface(_Strict):
                                                        allow_inf_nan=False)]] = None
     wind_direction_deg: Optional[Annotated[float, Field(ge=-360.0, le=360.0,
                                                         allow_inf_nan=False)]] = None
+    method: Optional[Literal["table", "walk"]] = None
 
     @model_validator(mode="after")
     def _slopes_given_once(self) -> "Surface":
-        rough = (self.wind_speed_m_s, self.mean_square_slope, self.wind_direction_deg)
+        rough = (self.wind_speed_m_s, self.mean_square_slope, self.wind_direction_deg,
+                 self.method)
         if self.model != "cox_munk":
             if any(v is not None for v in rough):
                 raise ValueError(f"surface.model = {self.model!r} has no slopes: "
-                                 "wind_speed_m_s, mean_square_slope and wind_direction_deg "
-                                 "belong to surface.model = 'cox_munk'")
+                                 "wind_speed_m_s, mean_square_slope, wind_direction_deg and "
+                                 "method belong to surface.model = 'cox_munk'")
             return self
         if (self.wind_speed_m_s is None) == (self.mean_square_slope is None):
             raise ValueError("surface.model = 'cox_munk' needs exactly one of wind_speed_m_s "
@@ -45,10 +54,28 @@ class Surface(_Strict):
             raise ValueError(f"surface.wind_direction_deg = {self.wind_direction_deg} needs "
                              "surface.wind_speed_m_s (the upwind/crosswind variances are "
                              "functions of the wind speed); drop it with mean_square_slope")
+        if self.method == "table" and self.wind_direction_deg is not None:
+            raise ValueError("surface.method = 'table' with surface.wind_direction_deg: the "
+                             "table is of isotropic slopes; use method 'walk' (the default "
+                             "with a wind direction) or drop wind_direction_deg")
         if self.fresnel != "exact":
             raise ValueError("surface.fresnel = 'schlick' with surface.model = 'cox_munk': "
                              "the facets use exact Fresnel; allowed: 'exact'")
         return self
+
+    def cap_lobe_tabulated(self) -> bool:
+        """Whether the nadir polar cap's local estimate can see through this surface: flat,
+        or waves of isotropic slopes with mean square slope at most MAX_CAP_MSS (the facets'
+        shadowing is then nil for the cap's light: kernel/rough_cap.py)."""
+        if self.model != "cox_munk":
+            return True
+        upwind, crosswind = self.slope_variances()
+        return upwind == crosswind and upwind + crosswind <= MAX_CAP_MSS
+
+    def tabulated(self) -> bool:
+        """Whether the rough surface is sampled from its table (else by its facet walk)."""
+        return self.model == "cox_munk" and (self.method or (
+            "walk" if self.wind_direction_deg is not None else "table")) == "table"
 
     def slope_variances(self) -> tuple[float, float]:
         """(upwind, crosswind) slope variances; isotropic: half the mean square slope each."""

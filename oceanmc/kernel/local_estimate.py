@@ -1,5 +1,6 @@
 """Local (next-event, point) estimates: of radiance in exact upward directions, and of the
-nadir-viewing polar-cap average (Lu, Lw_nadir, Rrs_nadir; tables in scene/estimates.py).
+nadir-viewing polar-cap average (Lu, Lw_nadir, Rrs_nadir; tables in scene/estimates.py; through
+the rough sea, the air cap's tables hold the surface's transmission lobe: kernel/rough_cap.py).
 
 At every collision a packet of weight w in a layer with scattering b and extinction c sends
 w (b/c) p(cos Theta) per steradian into the requested direction Omega; that light reaches a level
@@ -104,21 +105,28 @@ def cap_lookup(est, floats, table, i, f, n_wl, j):
 
 
 @internal
+def from_air_through_rough(surface, ax, ay, az, rng):
+    """(ix, iy, iz, t): for the upward air direction o = (ax, ay, -az) (az > 0), an in-water
+    direction of travel i whose light the rough surface sends into o, with t = 1, or t = 0
+    (nothing sent): one sample of the facet walk of a photon travelling -o from the air,
+    reversed. By the walk's reciprocity (f(i->o) / n_o^2 = f(o->i) / n_i^2 for a dielectric
+    BSDF; Veach 1997, PhD thesis, 5.2) the radiance L(o) at 0+ is the expectation of
+    t L_water(i) / n^2."""
+    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, -ax, -ay, az, uniform(rng),
+                                                          rng)
+    return -ox, -oy, -oz, weight if transmitted else 0.0
+
+
+@internal
 def into_water_through_rough(surface, est, floats, k, rng):
-    """(ix, iy, iz, t): for air row k (upward air direction o, stored as its flat-surface
-    refracted in-water direction), an in-water direction of travel i whose light the rough
-    surface sends into o, with t = 1, or t = 0 (nothing sent): one sample of the facet walk of
-    a photon travelling -o from the air, reversed. By the walk's reciprocity (f(i->o) / n_o^2 =
-    f(o->i) / n_i^2 for a dielectric BSDF; Veach 1997, PhD thesis, 5.2) the radiance L(o) at 0+
-    is the expectation of t L_water(i) / n^2, which the row's air factor 1/n^2 completes."""
+    """from_air_through_rough for air row k (its upward air direction stored as its
+    flat-surface refracted in-water direction); the row's air factor 1/n^2 completes it."""
     dx, dy, dz = direction(est, floats, k)
     n = surface.n_water
     ax = n * dx
     ay = n * dy
-    az = math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay))
-    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, -ax, -ay, az, uniform(rng),
-                                                          rng)
-    return -ox, -oy, -oz, weight if transmitted else 0.0
+    return from_air_through_rough(surface, ax, ay, math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay)),
+                                  rng)
 
 
 @internal
@@ -254,6 +262,18 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
                         -(tau[j] - floats[taus + level]) / mu)
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
+        if surface.delta == 0:
+            # the air cap's direction drawn uniformly, its light traced back through the
+            # rough sea to one in-water direction (unbiased for the cap average)
+            ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))
+            ix, iy, iz, t = from_air_through_rough(surface, ax, ay, mu_a, rng)
+            if t > 0.0 and iz < 0.0:
+                f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz) * t / (
+                    n_water * n_water)
+                for j in range(n):
+                    tally[grid.cap + grid.n_depths * n + j] += (
+                        weight[j] * f * math.exp(tau[j] / iz))
+            return
         sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n_water
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
         t = surface_bsdf.transmittance(surface, mu_w)

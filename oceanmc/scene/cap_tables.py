@@ -20,12 +20,23 @@ For 0+ the air cap (half-angle beta) is the water cap of half-angle asin(sin bet
 air-side average brings the Fresnel transmittance t and the solid-angle factor mu_w / mu_a
 (L_air = t L_water / n^2 and n^2 mu_w dOmega_w = mu_a dOmega_a), so g there is
 exp(-tau/mu) h(mu) with h = t(mu) / mu_a(mu).
+
+Through the wind-roughened sea the air cap receives light from every in-water direction W with
+the weight K(mu_W) of kernel/rough_cap.py (a smooth lobe a few degrees wide about straight up):
+the 0+ average is integral of w p(u . W) K(mu_W) g(mu_W) dW with g = exp(-tau/mu)/mu, expanded
+as above about K's mean cosine mu_bar, with M0 = integral p K dW and M1 = integral p K (mu_W -
+mu_bar) dW (RoughCap, rough_cap_moments). The neglected term, (g''/2) integral p K (mu_W -
+mu_bar)^2, is below 1e-4 tau^2 exp(-tau) relative to the first for K lobes within 15 deg of
+straight up (wind speeds to 20 m/s).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
+
+from ..kernel import rough_cap
 
 # alpha grid: fine where the cap and the forward peak overlap, coarser beyond
 ALPHA_FINE_SPAN_CAPS = 4.0
@@ -114,3 +125,72 @@ def air_factor(mu_w: np.ndarray, n: float, transmittance) -> np.ndarray:
     mu_a = np.sqrt(np.clip(1.0 - sin_a ** 2, 0.0, 1.0))
     t = np.array([transmittance(float(m)) for m in mu_w])
     return t / mu_a
+
+
+# K of the rough sea's air cap: found on a coarse grid of angles to ROUGH_SEARCH_DEG, then
+# tabulated on ROUGH_MU_NODES nodes uniform in mu down to where it falls below ROUGH_FLOOR of
+# its peak (and stays there), ROUGH_MARGIN_DEG beyond; quadrature over the air cap: Gauss-
+# Legendre in 1 - cos (ROUGH_POLAR_NODES) and the midpoint rule in azimuth (ROUGH_AZIMUTHS)
+ROUGH_SEARCH_DEG = 60.0
+ROUGH_FLOOR = 1e-13
+ROUGH_MARGIN_DEG = 1.0
+ROUGH_MU_NODES = 801
+ROUGH_POLAR_NODES = 16
+ROUGH_AZIMUTHS = 64
+# the circles of scattering angle psi that meet K's support: ROUGH_PSI_NODES uniform nodes,
+# each circle averaged at ROUGH_RING_NODES azimuths (midpoint rule on [0, pi])
+ROUGH_PSI_NODES = 401
+ROUGH_RING_NODES = 48
+
+
+@dataclass(frozen=True)
+class RoughCap:
+    """The rough sea's air cap, as cap_moments needs it: K on mu_nodes (its mean cosine mu_bar
+    and integral mass), and per alpha the psi intervals that meet its support with the circle
+    averages A (of K) and B (of K (mu - mu_bar)) at their midpoints."""
+    mu_nodes: np.ndarray
+    density: np.ndarray
+    mu_bar: float
+    mass: float
+    psi: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+
+
+def rough_air_density(alpha: float, n: float, beta: float) -> tuple[np.ndarray, np.ndarray]:
+    """(mu_nodes, K): kernel/rough_cap.py's K for the air cap of half-angle beta through facets
+    of Beckmann roughness alpha, on a uniform grid in mu over its support."""
+    x, w = np.polynomial.legendre.leggauss(ROUGH_POLAR_NODES)
+    polar, weights = 0.5 * (x + 1.0), 0.5 * w
+    azimuths = (np.arange(ROUGH_AZIMUTHS) + 0.5) * (math.pi / ROUGH_AZIMUTHS)
+    search = np.radians(np.linspace(0.0, ROUGH_SEARCH_DEG, 121))
+    coarse = rough_cap.air_cap_density(alpha, n, beta, np.cos(search), polar, weights, azimuths)
+    above = np.nonzero(coarse > ROUGH_FLOOR * coarse.max())[0]
+    end = min(math.radians(ROUGH_SEARCH_DEG), search[above[-1]] + math.radians(ROUGH_MARGIN_DEG))
+    mu = np.linspace(math.cos(end), 1.0, ROUGH_MU_NODES)
+    return mu, rough_cap.air_cap_density(alpha, n, beta, mu, polar, weights, azimuths)
+
+
+def rough_cap_geometry(alphas: np.ndarray, alpha: float, n: float, beta: float) -> RoughCap:
+    """The RoughCap of the air cap of half-angle beta through facets of roughness alpha, at
+    the alpha grid alphas (the angles between a packet's direction and straight up)."""
+    mu, density = rough_air_density(alpha, n, beta)
+    # integrals over the upper sphere of K and K mu: K linear in mu, dOmega = 2 pi dmu
+    mass = 2.0 * math.pi * np.trapezoid(density, mu)
+    mu_bar = float(2.0 * math.pi * np.trapezoid(density * mu, mu) / mass)
+    reach = math.acos(mu[0])
+    lo = np.clip(alphas - reach, 0.0, None)
+    hi = np.minimum(math.pi, alphas + reach)
+    psi = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, ROUGH_PSI_NODES)[None, :]
+    rings = (np.arange(ROUGH_RING_NODES) + 0.5) * (math.pi / ROUGH_RING_NODES)
+    a, b = rough_cap.ring_averages(alphas, psi, mu, density, mu_bar, rings)
+    return RoughCap(mu, density, mu_bar, float(mass), psi, a, b)
+
+
+def rough_cap_moments(table: tuple[np.ndarray, np.ndarray, np.ndarray], cap: RoughCap
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """(M0, M1) at each alpha for the rough sea's air cap: the probability of each psi interval
+    (exact, from the cumulative integral of q) times the circle averages at its midpoint."""
+    psi_grid, cdf, _ = table
+    mass = np.diff(np.interp(cap.psi, psi_grid, cdf), axis=1)
+    return np.sum(mass * cap.a, axis=1), np.sum(mass * cap.b, axis=1)

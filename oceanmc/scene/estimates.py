@@ -61,6 +61,22 @@ _CAP_FILES_KEPT = 256   # 83 kB each
 _CAP_SOURCE = hashlib.sha1(Path(cap_tables.__file__).read_bytes()).digest()
 
 
+def _save(path: Path, table: np.ndarray) -> None:
+    """Keeps a table in the disk cache, atomically (a concurrent run never reads half a file),
+    and the newest _CAP_FILES_KEPT files only; nothing on a read-only install (the tables are
+    then computed in each process)."""
+    try:
+        _CAP_DIR.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=_CAP_DIR, suffix=".npy", delete=False) as f:
+            np.save(f, table)
+        os.replace(f.name, path)
+        kept = sorted(_CAP_DIR.glob("*.npy"), key=lambda p: p.stat().st_mtime)
+        for old in kept[:-_CAP_FILES_KEPT]:
+            old.unlink(missing_ok=True)
+    except OSError:
+        pass
+
+
 def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) -> bytes:
     """A digest of the layer's phase functions: its components' models, weights at every
     wavelength, parameters and tables."""
@@ -112,21 +128,32 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes) -> np.ndarra
             table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, j, psi),
                                           breaks)
             out[:, :, j] = [*cap_tables.cap_moments(table, water),
-                            *cap_tables.cap_moments(table, air)]
+                            *(cap_tables.rough_cap_moments(table, air)
+                              if isinstance(air, cap_tables.RoughCap)
+                              else cap_tables.cap_moments(table, air))]
         _CAP_CACHE[key] = out
-        try:   # atomically, so that a concurrent run never reads half a file
-            _CAP_DIR.mkdir(parents=True, exist_ok=True)
-            with tempfile.NamedTemporaryFile(dir=_CAP_DIR, suffix=".npy", delete=False) as f:
-                np.save(f, out)
-            os.replace(f.name, path)
-            kept = sorted(_CAP_DIR.glob("*.npy"), key=lambda p: p.stat().st_mtime)
-            for old in kept[:-_CAP_FILES_KEPT]:
-                old.unlink(missing_ok=True)
-        except OSError:
-            pass   # a read-only install: the tables are computed in each process
+        _save(path, out)
         if len(_CAP_CACHE) > 64:
             _CAP_CACHE.pop(next(iter(_CAP_CACHE)))
     return _CAP_CACHE[key]
+
+
+def rough_mean_cosine(enabled: bool, roughness: float, n: float, beta: float,
+                      alphas: np.ndarray, caps) -> float:
+    """The mean cosine of the rough sea's lobe K (cap_tables.RoughCap), remembered on disk
+    with the moments (so that a start whose tables are cached builds no geometry); 1 when the
+    cap estimate is off."""
+    if not enabled:
+        return 1.0
+    key = hashlib.sha1(_CAP_SOURCE + np.array([roughness, n, beta]).tobytes()
+                       + alphas.tobytes()).hexdigest()
+    path = _CAP_DIR / f"mu-{key}.npy"
+    try:
+        return float(np.load(path)[0])
+    except (OSError, ValueError, IndexError):
+        mu_bar = caps()[1].mu_bar
+    _save(path, np.array([mu_bar]))
+    return mu_bar
 
 
 def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.ndarray,
@@ -143,12 +170,16 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     alphas = cap_tables.alpha_nodes(beta)
     enabled = config.nadir_local
     n_wl = len(config.wavelengths)
-    geometry = (beta, mu_w, beta_w, mu_a)
+    # through the rough sea (isotropic slopes: config/scene.py) the air cap's light comes from
+    # the in-water lobe K of kernel/rough_cap.py (cap_tables.RoughCap)
+    roughness = 0.0 if surface[0]["delta"] else float(surface[0]["alpha_u"])
+    geometry = (beta, mu_w, beta_w, mu_a, roughness, n)
 
     @functools.cache
     def caps():
         return (cap_tables.cap_geometry(beta, mu_w, alphas),
-                cap_tables.cap_geometry(beta_w, mu_a, alphas))
+                cap_tables.rough_cap_geometry(alphas, roughness, n, beta) if roughness
+                else cap_tables.cap_geometry(beta_w, mu_a, alphas))
 
     tables: dict[bytes, int] = {}
     table_of_layer = []
@@ -161,18 +192,26 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
             moments.append(layer_cap_moments(medium, mf, mi, layer, caps, key) if enabled
                            else np.zeros((4, len(alphas), n_wl)))
         table_of_layer.append(tables[key])
-    step = 1e-6
-    h = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
-                              lambda mu: transmittance(surface[0], mu))
     cap_solid_angle = 4.0 * math.pi * math.sin(beta / 2.0) ** 2  # 2 pi (1 - cos beta), stably
+    if roughness:
+        # K holds the surface's transmission and 1 / dOmega_a: g = exp(-tau/mu) / mu about
+        # K's mean cosine (the mean of K alone: the tables' M1 is taken about it)
+        mu_a = rough_mean_cosine(enabled, roughness, n, beta, alphas, caps)
+        h, dh, air_solid_angle = 1.0 / mu_a, -1.0 / (mu_a * mu_a), 1.0
+    else:
+        step = 1e-6
+        hs = cap_tables.air_factor(np.array([mu_a - step, mu_a, mu_a + step]), n,
+                                   lambda mu: transmittance(surface[0], mu))
+        h, dh, air_solid_angle = float(hs[1]), float((hs[2] - hs[0]) / (2.0 * step)), \
+            cap_solid_angle
     f, i = Pool(np.float64), Pool(np.int64)
     level_tau = column.level_tau
     rec = record(
         ESTIMATES, directions_on=int(len(dirs) > 0), cap_on=int(enabled), n_dirs=len(dirs),
         n_alpha=len(alphas), fine_end=fine_end, fine_step=fine_step, coarse_step=coarse_step,
         fine_nodes=int(fine_nodes), mu_w=mu_w, omega_w=cap_solid_angle,
-        cos_water=math.cos(beta), mu_a=mu_a, omega_a=cap_solid_angle,
-        cos_air=math.cos(beta), h=float(h[1]), dh=float((h[2] - h[0]) / (2.0 * step)),
+        cos_water=math.cos(beta), mu_a=mu_a, omega_a=air_solid_angle,
+        cos_air=math.cos(beta), h=h, dh=dh,
         dirs=f.add(dirs), air_factor=f.add(air_factor),
         # table-major, then alpha, then wavelength: a packet reads a row of n_wl
         **{f"cap_{name}": f.add(np.array([t[m] for t in moments]))
