@@ -98,7 +98,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .run.results import (MergeError, check_resumable, check_same_data_files,
                               format_summary, merge_results, scene_difference)
     from .run.compiling import CompileInterrupted
-    from .run.simulation import check_tally_memory, simulate
+    from .run.simulation import NonFiniteResult, check_tally_memory, simulate
     from . import scene
 
     configs = [Path(c) for c in args.configs]
@@ -160,11 +160,11 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         # the first placement refuses to replace a file another run made meanwhile; the
         # checkpoints that follow replace this run's own file
-        replace = {"ok": args.overwrite or previous is not None}
+        replace = {"ok": args.overwrite or previous is not None, "written": False}
 
         def checkpoint(partial, out=out, combined=combined, replace=replace):
             combined(partial).save(out, overwrite=replace["ok"])
-            replace["ok"] = True
+            replace["ok"] = replace["written"] = True
         try:
             result = simulate(config, threads=args.threads, progress=not args.quiet,
                               first_batch=first, should_stop=lambda: stop.requested,
@@ -176,6 +176,13 @@ def cmd_run(args: argparse.Namespace) -> int:
             return 2
         except MergeError as exc:
             raise UsageError(f"--resume: {exc}") from None
+        except NonFiniteResult as exc:
+            # a file this run's checkpoints made before the fault showed is not left as if the
+            # scene had run well; a resumed file keeps its last (finite) checkpoint
+            if replace["written"] and previous is None:
+                out.unlink(missing_ok=True)
+            print(f"oceanmc: error: {path}: {exc}", file=sys.stderr)
+            return 3
         except CompileInterrupted:
             # the compilation goes on in its own thread inside LLVM; leave at once, no file
             print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "

@@ -75,6 +75,37 @@ def check_tally_memory(config: SceneConfig, sc: scene.Scene) -> None:
             "or fewer batches")
 
 
+class NonFiniteResult(RuntimeError):
+    """A run whose tallies hold NaN or inf. The scene passed validation, so this is a fault of
+    oceanmc, not of the scene: refused (one line) rather than returned or written as results."""
+
+
+def check_finite(result: Result, wavelengths: np.ndarray) -> None:
+    """Raises NonFiniteResult naming the first quantity with a NaN or inf in its batches, the
+    wavelengths where it has one, and how many other quantities have one too."""
+    bad = [(name, q) for name, q in result.quantities.items()
+           if not np.isfinite(q.batches).all()]
+    if not bad:
+        return
+    name, q = bad[0]
+    flags = ~np.isfinite(q.batches)
+    kind = "NaN" if np.isnan(q.batches).any() else "inf"
+    if "wavelength" in q.dims:   # after the batch axis
+        axis = 1 + q.dims.index("wavelength")
+        per_wavelength = flags.any(axis=tuple(i for i in range(flags.ndim) if i != axis))
+        at = wavelengths[per_wavelength]
+    else:
+        at = np.asarray(wavelengths)[:1]
+    where = " at " + ", ".join(f"{w:g}" for w in at) + " nm" if np.isfinite(at).all() \
+        else ""   # a monochromatic scene's wavelength is nan: none to name
+    more = f", and in {len(bad) - 1} other quantit{'y' if len(bad) == 2 else 'ies'}" \
+        if len(bad) > 1 else ""
+    raise NonFiniteResult(
+        f"the run produced non-finite values ({kind}) in {name}{where}{more}: a fault of "
+        "oceanmc, not of the scene, which passed validation; no results were written; please "
+        "report it with the scene file")
+
+
 def next_budget(budget: int, seconds: float) -> int:
     """The work budget of a batch's next call from the last one's: scaled toward CALL_SECONDS,
     by at most 4x per call. The budget only decides where calls end, never what is traced."""
@@ -111,7 +142,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     should_stop() may end the run early: the Result then holds the leading whole batches, the
     state of the later ones begun, and is marked partial. on_checkpoint(result) receives such a
     partial Result every checkpoint_every_s seconds. progress: a progress bar on stderr, and a
-    notice there when the run looks like taking more than an hour."""
+    notice there when the run looks like taking more than an hour. A NaN or inf in the
+    tallies (a fault of oceanmc) raises NonFiniteResult, at the end or at a checkpoint."""
     if not isinstance(config, SceneConfig):
         config = load_config(config)
     # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
@@ -245,6 +277,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         # one wavelength: the monochromatic layout (no wavelength dimension)
         result = per_wavelength[0] if n_wl == 1 else \
             stack_wavelengths(per_wavelength, config.wavelengths)
+        # before a checkpoint or the end hands it on to be written or returned
+        check_finite(result, config.wavelengths)
         result.resume_state = state
         result.iops = iops_table(sc.layers, config.wavelengths)
         return result
