@@ -266,3 +266,31 @@ def test_more_than_100000_points_are_refused_before_any_is_built(monkeypatch):
     assert time.perf_counter() - start < 5.0
     assert len(load_sweep({"base": TINY, "axes": {"water.layers[0].a": {"linspace": [
         0.1, 1, 250]}, "bottom.reflectance": {"linspace": [0, 1, 400]}}}).axes) == 2
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"axes": {"chl": {"key": "water.layers[0].a", "values": [0.1, -1]}}},
+     "point (chl = -1): water.layers[0].a = -1: Input should be greater than or equal to 0"),
+    ({"axes": {"zip": {"chl": {"key": "water.layers[0].a", "values": [0.1, -2]},
+                       "bottom.reflectance": [0.1, 0.2]}}},
+     "point (chl = -2, bottom.reflectance = 0.2): water.layers[0].a = -2: "),
+    ({"axes": {"chl": {"key": "water.layers[0].a", "values": {"linspace": [0, 1, "x"]}}}},
+     "axes: chl.values.linspace = [0, 1, 'x']: expected [start, stop, num]"),
+    ({"axes": {"chl": {"key": "water.layers[0].a", "values": 5}}},
+     "axes: chl.values = 5: expected a non-empty list of values"),
+    ({"axes": {"chl": {"key": "water..a", "values": [1]}}},
+     "axes: chl.key: 'water..a' is not a key path"),
+    ({"axes": {"chl": {"key": "water.layerz[0].a", "values": [0.1]}}},
+     "axes: chl.key = water.layerz[0].a: water.layerz is an unknown key; did you mean "
+     "water.layers?"),
+    ({"axes": {"chl": {"key": "water.layers[3].a", "values": [0.1]}}},
+     "axes: chl.key = water.layers[3].a: water.layers has 1 entry in the base scene"),
+    ({"set": {"water.layers[3].a": 0.1}}, "set: water.layers[3].a: water.layers has 1 entry"),
+    ({"set": {"water..a": 0.1}}, "set: 'water..a' is not a key path"),
+])
+def test_messages_name_an_axis_as_the_sweep_file_wrote_it(changes, message):
+    """A named axis (`chl: {key: PATH, values: ...}`) was reported by its key path, the point's
+    coordinates too ('point (water.layers[0].a = -1)'), its generator as 'chl (PATH).linspace',
+    and a bad `set` path as 'axes: ...': each message now starts with what the user wrote."""
+    got = points_or_one_line({"base": TINY, **changes})
+    assert isinstance(got, str) and got.startswith(message), got

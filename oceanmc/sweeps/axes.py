@@ -43,51 +43,55 @@ class SweepError(ConfigError):
     point's coordinates where there is one, and what is allowed."""
 
 
-def parse_key_path(path: str) -> list[str | int]:
-    """`water.layers[0].a` -> ['water', 'layers', 0, 'a']."""
+def parse_key_path(path: str, where: str = "axes") -> list[str | int]:
+    """`water.layers[0].a` -> ['water', 'layers', 0, 'a']. `where` names the place in the
+    sweep file the path was written (axes, set, axes: NAME.key) in the one-line error."""
     if not isinstance(path, str) or not path:
-        raise SweepError(f"axes: {path!r} is not a key path (e.g. water.layers[0].a)")
+        raise SweepError(f"{where}: {path!r} is not a key path (e.g. water.layers[0].a)")
     steps: list[str | int] = []
     for segment in path.split("."):
         match = _SEGMENT.match(segment)
         if match is None:
-            raise SweepError(f"axes: {path!r} is not a key path: {segment!r} should be a key "
+            raise SweepError(f"{where}: {path!r} is not a key path: {segment!r} should be a key "
                              "optionally followed by list indices, e.g. layers[0]")
         steps.append(match.group(1))
         steps += [int(i) for i in _INDEX.findall(match.group(2))]
     return steps
 
 
-def set_key_path(scene: dict, path: str, value: Any) -> None:
+def set_key_path(scene: dict, path: str, value: Any, written: str | None = None) -> None:
     """Sets the value at a key path in a scene mapping (in place). Missing mappings on the way are
-    created (a key the base scene leaves at its default); a list index must exist."""
-    steps = parse_key_path(path)
+    created (a key the base scene leaves at its default); a list index must exist. `written`:
+    how the sweep file gave the path, which starts the one-line error (default `axes: PATH`;
+    `set: PATH`, or `axes: NAME.key = PATH` for a named axis)."""
+    written = written or f"axes: {path}"
+    steps = parse_key_path(path, written.split(":")[0])
     node: Any = scene
     for depth, (step, following) in enumerate(zip(steps, steps[1:] + [None])):
         where = _render(steps[:depth]) or "the scene"
         last = following is None
         if isinstance(step, int):
             if not isinstance(node, list):
-                raise SweepError(f"axes: {path}: {where} is not a list, so [{step}] does not "
+                raise SweepError(f"{written}: {where} is not a list, so [{step}] does not "
                                  "apply")
             if not -len(node) <= step < len(node):
-                raise SweepError(f"axes: {path}: {where} has {len(node)} entr"
+                raise SweepError(f"{written}: {where} has {len(node)} entr"
                                  f"{'y' if len(node) == 1 else 'ies'} in the base scene; allowed "
                                  f"indices {-len(node)} .. {len(node) - 1}")
         elif not isinstance(node, dict):
-            raise SweepError(f"axes: {path}: {where} is not a mapping, so it has no key "
+            raise SweepError(f"{written}: {where} is not a mapping, so it has no key "
                              f"{step!r}")
         if last:
             node[step] = value
         elif isinstance(step, str) and node.get(step) is None:
-            _check_missing_key(path, steps, depth, node)
+            _check_missing_key(written, steps, depth, node)
             node[step] = {}   # following is a key: a list index needs the base scene's list
             node = node[step]
         else:
             node = node[step]
 
 
-def _check_missing_key(path: str, steps: list[str | int], depth: int, node: dict) -> None:
+def _check_missing_key(written: str, steps: list[str | int], depth: int, node: dict) -> None:
     """A key on the way that the base scene lacks is created as a mapping if the scene allows it
     there; an unknown key (with the nearest valid one: the schema's keys at that level and the
     base scene's) or one followed by a list index (there is no list to index) is refused."""
@@ -98,9 +102,9 @@ def _check_missing_key(path: str, steps: list[str | int], depth: int, node: dict
                                           cutoff=0.6)
         hint = f"; did you mean {_render(steps[:depth] + [close[0]])}?" if close else \
             f"; allowed keys there: {', '.join(sorted(allowed))}"
-        raise SweepError(f"axes: {path}: {_render(steps[:depth + 1])} is an unknown key{hint}")
+        raise SweepError(f"{written}: {_render(steps[:depth + 1])} is an unknown key{hint}")
     if isinstance(following, int):
-        raise SweepError(f"axes: {path}: the base scene has no {_render(steps[:depth + 1])}, so "
+        raise SweepError(f"{written}: the base scene has no {_render(steps[:depth + 1])}, so "
                          f"[{following}] does not apply; give {_render(steps[:depth + 1])} in the "
                          "base scene, or make the whole list an axis's value")
 
@@ -183,6 +187,11 @@ class SweepSpec:
     def shape(self) -> tuple[int, ...]:
         return tuple(len(axis) for axis in self.axes)
 
+    @property
+    def names(self) -> dict[str, str]:
+        """{key path: the name the sweep file gave it}: its short name, else the path."""
+        return {key: axis.name(k) for axis in self.axes for k, key in enumerate(axis.keys)}
+
     def points(self):
         """(index tuple, [(key path, value), ...]) for every point, in C order."""
         for index in itertools.product(*(range(len(axis)) for axis in self.axes)):
@@ -190,10 +199,22 @@ class SweepSpec:
                           for k, key in enumerate(axis.keys)]
 
     def scene_at(self, assignments) -> dict:
+        """The base scene with the settings and a point's (key path, value) assignments; a
+        path that does not fit the base scene is refused as the sweep file wrote it."""
         scene = copy.deepcopy(self.base)
-        for key, value in list(self.settings.items()) + list(assignments):
-            set_key_path(scene, key, value)
+        for key, value in self.settings.items():
+            set_key_path(scene, key, value, f"set: {key}")
+        names = self.names
+        for key, value in assignments:
+            name = names.get(key, key)
+            set_key_path(scene, key, value, None if name == key else f"axes: {name}.key = {key}")
         return scene
+
+    def label(self, assignments) -> str:
+        """A point's coordinates for messages, by the names the sweep file gave its axes:
+        `chl = 0.3, bottom.reflectance = 0.2`."""
+        names = self.names
+        return label([(names.get(key, key), value) for key, value in assignments])
 
     def to_yaml(self) -> str:
         """The sweep as a YAML text (stored in the dataset's attributes; load_sweep reads its
@@ -239,7 +260,7 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     if not isinstance(settings, dict):
         raise SweepError(f"set: expected a mapping of key paths to values, got {settings!r}")
     for key in settings:
-        parse_key_path(key)
+        parse_key_path(key, "set")
     axes = _axes(data.get("axes"))
     total = math.prod(len(axis) for axis in axes)
     if total > MAX_POINTS:   # before any point is built
@@ -346,8 +367,8 @@ def _entry(name: str, spec: Any) -> tuple[str, str | None, tuple[Any, ...]]:
             raise SweepError(f"axes: {name}: the name is taken by the sweep dataset's own "
                              f"dimensions or variables; choose another (e.g. {name}_axis)")
         path = spec["key"]
-        parse_key_path(path)
-        return path, name, _values(f"{name} ({path})", spec["values"])
+        parse_key_path(path, f"axes: {name}.key")
+        return path, name, _values(f"{name}.values", spec["values"])
     parse_key_path(name)
     return name, None, _values(name, spec)
 

@@ -19,7 +19,7 @@ import yaml
 from .. import __version__
 from ..run.hdf5 import COORD_UNITS, load_result, place_atomically
 from ..run.results import Result, merge_results, scene_difference
-from .axes import SweepError, SweepSpec, coordinate, label, load_sweep
+from .axes import SweepError, SweepSpec, coordinate, load_sweep
 from .points import Point
 
 DONE, FAILED, PENDING = "done", "failed", "pending"
@@ -242,7 +242,7 @@ def check_replaceable(path: Path, folder: Path, spec: SweepSpec) -> None:
     else:
         more = f", and {len(missing) - 1} more of its {len(old_scenes)} points" \
             if len(missing) > 1 else ""
-        why = f"its point ({label(missing[0])}) is not one of this sweep's{more}"
+        why = f"its point ({old.label(missing[0])}) is not one of this sweep's{more}"
     raise OutputExists(f"{path} holds the dataset of another sweep ({why}); {how}")
 
 

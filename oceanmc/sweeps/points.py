@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
-from .axes import SweepError, SweepSpec, label
+from .axes import SweepError, SweepSpec
 
 
 @dataclass(frozen=True)
@@ -48,7 +48,7 @@ def build_points(spec: SweepSpec) -> list[Point]:
     points: list[Point] = []
     bad: list[str] = []
     for index, assignments in spec.points():
-        where = label(assignments)
+        where = spec.label(assignments)   # by the names the sweep file gave its axes
         try:
             config = load_config(spec.scene_at(assignments), base_dir=spec.base_dir)
         except SweepError as exc:
