@@ -251,3 +251,20 @@ def sampling_ratios(foms: list[dict]) -> list[dict]:
                         "fom_cosine_split": split, "ratio": fom / cosine,
                         "ratio_split": split / cosine})
     return out
+
+
+def kernel_commit() -> str:
+    """The last commit that changed the compiled kernel (oceanmc/kernel/), with '+' when the
+    working tree changes it too, for a report to say what it measured; 'unknown' outside a
+    git checkout."""
+    import subprocess
+    kernel = Path(__file__).resolve().parents[1] / "kernel"
+    try:
+        commit = subprocess.run(["git", "log", "-1", "--format=%h", "--", str(kernel)],
+                                cwd=kernel, capture_output=True, text=True, timeout=10,
+                                check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", str(kernel)], cwd=kernel,
+                               capture_output=True, text=True, timeout=10, check=True).stdout
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return (commit or "unknown") + ("+" if dirty.strip() else "")

@@ -1,11 +1,16 @@
 """How photon weights evolve: implicit or analog, roulette, splitting, upward-biased scattering."""
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional
+from typing import Annotated, Literal, Optional, Union
 
 from pydantic import Field
 
 from .base import _Strict
+
+
+# auto's upward fraction in spectral scenes: the Rrs nadir of a 31-band windy Case-1 scene to 1%
+# in 20-30 s where it took 1,000-10,000 s without it (benchmarks/real_scenes.md)
+AUTO_UPWARD_FRACTION = 0.1
 
 
 class Estimator(_Strict):
@@ -17,14 +22,16 @@ class Estimator(_Strict):
     upward_fraction: the largest fraction of scattering events that draw the new direction
     uniformly in the cone of half-angle upward_cone_deg around straight up (in a layer of
     single-scattering albedo w0 the fraction is min(upward_fraction, 1 - w0)); for Lu,
-    Lw_nadir and Rrs_nadir; off (null) by default."""
+    Lw_nadir and Rrs_nadir. auto (the default): AUTO_UPWARD_FRACTION in a spectral scene of
+    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py)."""
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
     max_events: Annotated[int, Field(ge=100, le=10**12)] = 1_000_000
     split_weight: Optional[Annotated[float, Field(gt=1.0, allow_inf_nan=False)]] = None
-    # scattering biased toward straight up (kernel/upward.py): off (null) by default
-    upward_fraction: Optional[Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)]] = None
+    # scattering biased toward straight up (kernel/upward.py)
+    upward_fraction: Union[Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)],
+                           Literal["auto"], None] = "auto"
     # at least 0.01 deg: the kernel draws cos psi = 1 - u (1 - cos A), whose 1 - cos A is
     # accurate to 1e-8 relative there and loses all accuracy near 1e-6 deg
     upward_cone_deg: Annotated[float, Field(ge=0.01, le=90.0, allow_inf_nan=False)] = 15.0

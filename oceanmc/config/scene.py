@@ -8,7 +8,7 @@ from pydantic import Field, field_validator, model_validator
 
 from .base import _Strict
 from .bottom import Bottom, bottom_has_mirror, bottom_weight_bounded
-from .estimator import Estimator
+from .estimator import AUTO_UPWARD_FRACTION, Estimator
 from .illumination import Illumination
 from .surface import MAX_CAP_MSS, Surface
 from .tallies import Tallies
@@ -105,6 +105,10 @@ class SceneConfig(_Strict):
             raise ValueError(f"tallies.local_directions_deg with bottom.model = "
                              f"{self.bottom.model!r}: a mirror has no density for a local "
                              "estimate; use the quad radiances")
+        if self.estimator.upward_fraction == "auto":
+            # resolved here, so that the stored config says what ran
+            self.estimator.upward_fraction = AUTO_UPWARD_FRACTION if (
+                self.estimator.mode == "implicit" and len(self.wavelengths) > 1) else None
         if self.estimator.mode == "analog" and self.estimator.upward_fraction is not None:
             raise ValueError(f"estimator.upward_fraction = {self.estimator.upward_fraction} "
                              "with estimator.mode = 'analog': the biased scattering changes "
@@ -120,14 +124,14 @@ class SceneConfig(_Strict):
     @property
     def nadir_local(self) -> bool:
         """Whether Lu, Lw_nadir and Rrs_nadir come from the local (cap) estimator (auto: unless
-        the bottom is a mirror, the sea rough, or the scene spectral: the one-history walk's
-        local estimate scores every wavelength at every collision, which costs it 4 to 7 times
-        the crossing walk's time per photon for 3 to 15 times less variance, a figure of merit
-        below the crossing estimate's over a bottom; benchmarks/README.md)."""
+        the bottom is a mirror, or the waves are anisotropic or steeper than the cap's tables
+        allow: Surface.cap_lobe_tabulated). Measured in 31-band Case-1 scenes, deep and over a
+        bottom, flat and at 7 m/s, with auto's upward bias: the local estimate's figure of
+        merit for Rrs is several times the crossing estimate's in every band
+        (benchmarks/real_scenes.md)."""
         mode = self.tallies.nadir_estimator
         return mode == "local" or (mode == "auto" and not bottom_has_mirror(self.bottom)
-                                   and self.surface.model != "cox_munk"
-                                   and len(self.wavelengths) == 1)
+                                   and self.surface.cap_lobe_tabulated())
 
     @property
     def wavelengths(self):
