@@ -35,7 +35,7 @@ def spectral_result():
 
 def test_spectral_summary_names_estimators_and_shows_what_was_asked(spectral_result):
     text = format_summary(spectral_result)
-    head = next(line for line in text.splitlines() if line.strip().startswith("nm"))
+    head = " ".join(line for line in text.splitlines() if line.strip().startswith("nm"))
     for column in ("Ed(0+)", "Rrs nadir", "Rrs 180,0", "Rrs 140,135", "Eu(0+)", "Ed(0-)"):
         assert column in head, column
     # auto: the crossing estimate for a spectral scene, and the summary says so
@@ -49,6 +49,31 @@ def test_spectral_summary_names_estimators_and_shows_what_was_asked(spectral_res
     cells = row.split()
     assert float(cells[1]) == pytest.approx(spectral_result["air/Ed"][1], rel=1e-3)
     assert float(cells[7]) == pytest.approx(spectral_result["air/Rrs_local"][1, 1], rel=1e-3)
+
+
+def test_the_spectral_table_fits_100_columns_in_blocks_that_keep_every_column(spectral_result):
+    """The table of configs/case1_spectral.yaml was 149 characters wide (8 columns of 16,
+    more with local_directions_deg): it is printed in blocks of at most 5 columns, each after
+    the nm column, the surface's (Ed(0+), the Rrs columns, Eu(0+)) first, every wavelength in
+    each block, and every line of the summary fits 100 characters."""
+    text = format_summary(spectral_result)
+    assert max(map(len, text.splitlines())) <= 100, text
+    heads = [line.split() for line in text.splitlines() if line.strip().startswith("nm")]
+    assert [" ".join(head) for head in heads] == [
+        "nm Ed(0+) Rrs nadir Rrs 180,0 Rrs 140,135 Eu(0+)",
+        "nm Ed(0-) Eu(0-) Eo(0-) leaving total"]
+    rows = [line.split()[0] for line in text.splitlines()
+            if line.strip()[:3] in ("440", "550", "670")]
+    assert rows == ["440", "550", "670"] * 2
+    many = dict(SPECTRAL, tallies={"depths_m": [0], "local_directions_deg": [
+        [180, 0], [170, 0], [160, 0], [150, 0], [140, 0]]}, photons=400)
+    text = format_summary(oceanmc.simulate(many, threads=1))
+    assert max(map(len, text.splitlines())) <= 100, text
+    heads = [" ".join(line.split()) for line in text.splitlines()
+             if line.strip().startswith("nm")]
+    assert heads == ["nm Ed(0+) Rrs nadir Rrs 180,0 Rrs 170,0 Rrs 160,0",
+                     "nm Rrs 150,0 Rrs 140,0 Eu(0+)",
+                     "nm Ed(0-) Eu(0-) Eo(0-) leaving total"], heads
 
 
 def test_spectral_summary_with_the_local_nadir_estimate_says_so(tmp_path):

@@ -568,10 +568,17 @@ SPECTRAL_COLUMNS = (("Ed(0+)", "air/Ed", None), ("Rrs nadir", "air/Rrs_nadir", N
                     ("leaving", "budget/water_leaving", None), ("total", "budget/total", None))
 
 
+# the printed summary fits a terminal this wide: a spectral table's nm column (8 characters)
+# and SPECTRAL_BLOCK columns of 16 (a value, its relative standard error)
+SUMMARY_WIDTH = 100
+SPECTRAL_BLOCK = (SUMMARY_WIDTH - 8) // 16
+
+
 def format_spectrum(result: Result) -> list[str]:
     """A spectral run as a table: one row per wavelength, the headline quantities in columns
-    (z1: the first tally depth), each value with its relative standard error in %; then what
-    the Rrs columns are (their estimators) and where the light came from."""
+    (z1: the first tally depth), each value with its relative standard error in %, in blocks of
+    columns no wider than SUMMARY_WIDTH; then what the Rrs columns are (their estimators) and
+    where the light came from."""
     depths = result.coords["depth"]
     first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
     columns = []
@@ -581,16 +588,31 @@ def format_spectrum(result: Result) -> list[str]:
         if name == "air/Rrs_nadir":
             columns += [(f"Rrs {direction_label(result, k)}", "air/Rrs_local", (slice(None), k))
                         for k in local_directions(result)]
-    lines = [f"  {'nm':>6}" + "".join(f" {head:>15}" for head, _, _ in columns)]
-    for k, wavelength in enumerate(result.coords["wavelength"]):
-        cells = []
-        for _, name, (_, index) in columns:
+    cells = []   # per column: its cell per wavelength
+    for _, name, (_, index) in columns:
+        column = []
+        for k in range(len(result.coords["wavelength"])):
             value, err = result[name][k], result.stderr(name)[k]
             if index is not None:
                 value, err = value[index], err[index]
             rel = abs(err / value) if value != 0.0 else 0.0
-            cells.append(f"{value:>9.4g} {rel:>5.1%}")
-        lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>15}" for cell in cells))
+            column.append(f"{value:>9.4g} {rel:>5.1%}")
+        cells.append(column)
+    # the table is printed in blocks of at most SPECTRAL_BLOCK columns, each after the nm
+    # column, so that a line fits a terminal of SUMMARY_WIDTH characters: the quantities at
+    # the surface (Ed(0+), the Rrs columns, Eu(0+)) first, then those in the water and the budget
+    surface = next(i for i, (_, name, _) in enumerate(columns + [("", "Ed", 0)])
+                   if name in ("Ed", "Eu", "Eo") or name.startswith("budget/"))
+    blocks = [range(start, min(start + SPECTRAL_BLOCK, end))
+              for begin, end in ((0, surface), (surface, len(columns)))
+              for start in range(begin, end, SPECTRAL_BLOCK)]
+    lines = []
+    for b, block in enumerate(blocks):
+        if b:
+            lines.append("")
+        lines.append(f"  {'nm':>6}" + "".join(f" {columns[c][0]:>15}" for c in block))
+        lines += [f"  {wavelength:>6g}" + "".join(f" {cells[c][k]:>15}" for c in block)
+                  for k, wavelength in enumerate(result.coords["wavelength"])]
     lines += estimator_lines(result)
     lines += illumination_lines(result)
     lines.append("  (value and relative standard error; irradiances in the units of Ed(0+), "
