@@ -234,6 +234,7 @@ def cmd_merge(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
+    from .run.derived import format_derived
     from .run.hdf5 import load_result
     from .run.results import format_summary
 
@@ -245,6 +246,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     except ValueError as exc:  # ResultsFileError: one line saying what is wrong
         raise UsageError(f"{path}: {exc}") from None
     print(format_summary(result))
+    print(format_derived(result))
     if args.config:
         print(result.config_yaml)
     return 0

@@ -10,6 +10,7 @@ import oceanmc
 from oceanmc.cli import main
 from oceanmc.config import load_config
 from oceanmc.optics import illumination_spectrum
+from oceanmc.run.derived import format_derived
 from oceanmc.run.results import format_summary
 
 SPECTRAL = {
@@ -104,7 +105,10 @@ def test_a_rough_sea_without_the_exact_nadir_is_told_how_to_get_it():
 def test_show_prints_the_same_summary(spectral_result, tmp_path, capsys):
     path = spectral_result.save(tmp_path / "s.h5")
     assert main(["show", str(path)]) == 0
-    assert capsys.readouterr().out.strip() == format_summary(oceanmc.load_result(path)).strip()
+    out = capsys.readouterr().out   # the run's summary, then the derived quantities
+    derived = format_derived(oceanmc.load_result(path))
+    assert derived.startswith("  derived (") and out.endswith(derived + "\n")
+    assert out[:-len(derived) - 1].strip() == format_summary(oceanmc.load_result(path)).strip()
     assert format_summary(oceanmc.load_result(path)) == format_summary(spectral_result)
 
 

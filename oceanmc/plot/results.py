@@ -5,7 +5,10 @@
 - Ed, Eu and Eo against depth, one line per selected wavelength, log irradiance axis, error bars
   of one standard error;
 - the radiance distribution at one depth and at 0+ (group air) on the polar quads, the downwelling
-  and the upwelling hemispheres side by side.
+  and the upwelling hemispheres side by side;
+- for a spectral file, the diffuse attenuation Kd and the irradiance reflectance R against
+  wavelength (group derived, run/derived.py), a line per tally interval and depth, shaded +- one
+  standard error.
 
 Files are read with xarray. A spectral file has a coordinate `wavelength` (nm) as the leading
 dimension of every spectral quantity; a monochromatic file has none, and both are drawn.
@@ -33,6 +36,7 @@ class ResultFile:
     water: object          # xarray.Dataset of the root group (in water)
     air: object            # xarray.Dataset of the group air (0+)
     path: Path
+    derived: object = None  # xarray.Dataset of the group derived; None in a file without it
 
     @property
     def wavelengths(self) -> np.ndarray | None:
@@ -64,7 +68,11 @@ def open_result(path: str | Path) -> ResultFile:
         air = xr.load_dataset(path, engine="h5netcdf", group="air")
     except (OSError, ValueError):
         raise PlotInputError(f"{path}: not an oceanmc results file (no group air)") from None
-    return ResultFile(water, air, path)
+    try:
+        derived = xr.load_dataset(path, engine="h5netcdf", group="derived")
+    except (OSError, ValueError):   # written before oceanmc derived them, or no whole batch
+        derived = None
+    return ResultFile(water, air, path, derived)
 
 
 def _listed(values: np.ndarray, most: int = 12) -> str:
@@ -163,6 +171,39 @@ PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward pla
                       ("Eo", "scalar irradiance Eo"))
 
 
+def kd_r_figure(result: ResultFile):
+    """Kd (one line per interval between adjacent tally depths) and R = Eu/Ed (one line per
+    tally depth) against wavelength, at most MAX_DERIVED_LINES of each, shaded +- one standard
+    error (the jackknife over batches of run/derived.py)."""
+    derived, grid = result.derived, result.wavelengths
+    fig, axes = panels(2, 2, (4.8, 4.0))
+    for ax, name, dim, title in ((axes[0], "Kd", "depth_interval",
+                                  "diffuse attenuation of Ed, Kd"),
+                                 (axes[1], "R", "depth", "irradiance reflectance R = Eu/Ed")):
+        count = derived.sizes[dim]
+        picks = np.unique(np.round(np.linspace(0, count - 1, min(count, MAX_DERIVED_LINES))))
+        for k, i in enumerate(int(i) for i in picks):
+            value = np.asarray(derived[name].isel({dim: i}))
+            err = np.asarray(derived[name + "_stderr"].isel({dim: i}))
+            if dim == "depth":
+                z = float(derived["depth"][i])
+                label = "0-" if z == 0.0 else f"{z:g} m"
+            else:
+                label = (f"{float(derived['depth_upper'][i]):g}-"
+                         f"{float(derived['depth_lower'][i]):g} m")
+            ax.fill_between(grid, value - err, value + err, color=f"C{k}", alpha=0.25)
+            ax.plot(grid, value, "o-", ms=3, color=f"C{k}", label=label)
+        units = derived[name].attrs.get("units", "")
+        ax.set_xlabel("wavelength (nm)")
+        ax.set_ylabel(f"{name} ({units})" if units and units != "1" else name)
+        ax.set_title(title, fontsize=9)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, title="depths", title_fontsize=7)
+    if np.nanmin(np.asarray(derived["Kd"])) > 0.0:
+        axes[0].set_yscale("log")
+    return fig
+
+
 def profiles_figure(result: ResultFile, indices: list[int]):
     """Ed, Eu and Eo against depth (one panel each), one line per wavelength index (indices []:
     monochromatic), irradiance on a log axis, error bars of one standard error."""
@@ -247,7 +288,11 @@ def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
 
 
 # the quantity each figure needs, for the note when a file lacks it
-NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed", "radiance": "radiance (tallies.radiance: false)"}
+NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed", "radiance": "radiance (tallies.radiance: false)",
+         "kd_r": "derived/Kd and derived/R (group derived: written by an oceanmc that derives "
+                 "them, from at least two tally depths)"}
+# at most this many depths (and intervals) get a line in the Kd and R panels, evenly spaced
+MAX_DERIVED_LINES = 4
 
 
 def _drawn_values(result: ResultFile, indices: list[int], depth: int,
@@ -261,6 +306,10 @@ def _drawn_values(result: ResultFile, indices: list[int], depth: int,
         if name in result.water:
             drawn["profiles"][name] = np.array([np.asarray(_at(result.water[name], i))
                                                 for i in lines])
+    derived = result.derived
+    if result.wavelengths is not None:   # Kd(l) and R(l): spectral files only
+        drawn["kd_r"] = {f"derived/{name}": np.asarray(derived[name]) for name in ("Kd", "R")
+                         if derived is not None and "Kd" in derived and "R" in derived}
     if "radiance" in result.water:
         drawn["radiance"]["radiance"] = np.asarray(
             _at(result.water["radiance"], wavelength).isel(depth=depth))
@@ -278,13 +327,13 @@ def _all_nan(values: dict[str, np.ndarray]) -> bool:
 def plot_result(path: str | Path, out: str | Path | None = None, depth: float | None = None,
                 wavelength: float | None = None) -> dict[str, Path | str]:
     """Writes the figures of a results file as PNG; returns each figure's path by name (rrs,
-    profiles, radiance), or, for one not drawn, why: the words that follow the file's name in
-    a note ("has no radiance (...)", "holds only NaN in ..."). A figure whose every value is
-    NaN is not drawn; a file of which nothing can be drawn (every value NaN: a run stopped
-    before its first whole batch) is a PlotInputError. out: a folder (existing, or ending in
-    '/'), the files then named after the results file, or a prefix to which _rrs.png,
-    _profiles.png, _radiance.png are appended; by default the results file's path without
-    .h5."""
+    profiles, radiance, and kd_r for a spectral file), or, for one not drawn, why: the words
+    that follow the file's name in a note ("has no radiance (...)", "holds only NaN in ...").
+    A figure whose every value is NaN is not drawn; a file of which nothing can be drawn (every
+    value NaN: a run stopped before its first whole batch) is a PlotInputError. out: a folder
+    (existing, or ending in '/'), the files then named after the results file, or a prefix to
+    which _rrs.png, _profiles.png, _radiance.png (and _kd_r.png) are appended; by default the
+    results file's path without .h5."""
     result = open_result(path)
     at_depth = depth_index(result, depth)
     indices = wavelength_indices(result, wavelength)
@@ -306,7 +355,8 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
         raise PlotInputError(f"{result.path}: every value to plot is NaN{why}; nothing to plot")
     makers = {"rrs": lambda: rrs_figure(result),
               "profiles": lambda: profiles_figure(result, indices),
-              "radiance": lambda: radiance_figure(result, at_depth, radiance_wavelength)}
+              "radiance": lambda: radiance_figure(result, at_depth, radiance_wavelength),
+              "kd_r": lambda: kd_r_figure(result)}
     prefix.parent.mkdir(parents=True, exist_ok=True)
     return {name: skipped[name] if name in skipped else
             save(makers[name](), f"{prefix}_{name}.png") for name in drawn}

@@ -15,6 +15,7 @@ import h5py
 import numpy as np
 import yaml
 
+from .derived import write_derived
 from .results import Quantity, Result
 
 FORMAT_VERSION = 1
@@ -242,6 +243,7 @@ def _write(f: h5py.File, result: Result) -> None:
             group.create_dataset(name, data=values)
     if result.iops:
         _write_iops(f.create_group("iops"), result.iops)
+    write_derived(f, result)
 
 
 IOPS_COORDS = {"layer_top": ("m", "depth of the top of each homogeneous layer (a depth profile "

@@ -52,26 +52,28 @@ BB_SMALL = BB_LARGE + 0.01 / SMALL_SHARE_COEF
 EDGE_NM = 10.0          # the table span whose log-slope continues a_p beyond each end
 
 
-def _table_ap(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+def _coefficients(wavelengths_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A_p and E_p interpolated linearly in the Bricaud table (400-700 nm)."""
     table = packaged(BRICAUD)
     nodes = table["wavelength_nm"]
-    return (np.interp(wavelengths_nm, nodes, table["A_p"])
-            * chl ** np.interp(wavelengths_nm, nodes, table["E_p"]))
+    return (np.interp(wavelengths_nm, nodes, table["A_p"]),
+            np.interp(wavelengths_nm, nodes, table["E_p"]))
 
 
 def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_p (1/m) at any wavelength: the Bricaud table inside 400-700 nm, its edge log-slope
-    continued outside."""
+    """a_p (1/m) at any wavelength, Chl > 0: the Bricaud table inside 400-700 nm, its edge
+    log-slope at that Chl continued outside (in logarithms, which do not underflow)."""
     nodes = packaged(BRICAUD)["wavelength_nm"]
     low, high = float(nodes[0]), float(nodes[-1])
     wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    out = _table_ap(chl, np.clip(wl, low, high))
-    for edge, inner in ((low, low + EDGE_NM), (high, high - EDGE_NM)):
-        outside = wl < low if edge == low else wl > high
+    a_coef, e_coef = _coefficients(np.clip(wl, low, high))
+    out = a_coef * chl ** e_coef
+    for edge, inner, outside in ((low, low + EDGE_NM, wl < low), (high, high - EDGE_NM, wl > high)):
         if outside.any():
-            at_edge, at_inner = _table_ap(chl, np.array([edge, inner]))
-            slope = math.log(at_edge / at_inner) / (edge - inner)   # d ln a_p / d lambda
-            out[outside] = at_edge * np.exp(slope * (wl[outside] - edge))
+            a_pair, e_pair = _coefficients(np.array([edge, inner]))
+            log_pair = np.log(a_pair) + e_pair * math.log(chl)     # ln a_p at edge and inner
+            slope = (log_pair[0] - log_pair[1]) / (edge - inner)  # d ln a_p / d lambda
+            out[outside] = np.exp(log_pair[0] + slope * (wl[outside] - edge))
     return out
 
 
