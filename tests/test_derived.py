@@ -109,6 +109,12 @@ def test_the_file_holds_them_and_show_prints_them(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "Kd(2 m..2.5 m)" in out and "mu_d(0-)" in out and "Q(6 m)" in out
     assert "jackknife" in format_derived(result)
+    # one tally depth: the ratios, no K and no empty depth_interval dimension
+    one = scene(photons=16 * 200)
+    one["tallies"]["depths_m"] = [0.0]
+    path = oceanmc.simulate(one, threads=2).save(tmp_path / "one.h5")
+    with xr.open_dataset(path, engine="h5netcdf", group="derived") as data:
+        assert dict(data.sizes) == {"depth": 1} and "R" in data and "Kd" not in data
 
 
 def test_a_spectral_file_plots_kd_and_r(tmp_path, capsys):

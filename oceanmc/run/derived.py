@@ -137,18 +137,20 @@ def write_derived(f, result) -> None:
     coords = dict(intervals(result.coords["depth"]), depth=result.coords["depth"])
     if "wavelength" in result.coords:
         coords["wavelength"] = result.coords["wavelength"]
+    used = {dim for d in derived.values() for dim in d.dims}   # no K with one tally depth
     scales = {}
     for dim in ("depth", "depth_interval", "wavelength"):
-        if dim in coords:
+        if dim in used:
             ds = group.create_dataset(dim, data=np.asarray(coords[dim], dtype=np.float64))
             ds.make_scale(dim)
             ds.attrs["units"], ds.attrs["description"] = COORDS[dim]
             scales[dim] = ds
-    scales["depth_interval"].attrs["coordinates"] = "depth_upper depth_lower"
-    for aux in ("depth_upper", "depth_lower"):
-        ds = group.create_dataset(aux, data=coords[aux])
-        ds.attrs["units"], ds.attrs["description"] = COORDS[aux]
-        ds.dims[0].attach_scale(scales["depth_interval"])
+    if "depth_interval" in used:
+        scales["depth_interval"].attrs["coordinates"] = "depth_upper depth_lower"
+        for aux in ("depth_upper", "depth_lower"):
+            ds = group.create_dataset(aux, data=coords[aux])
+            ds.attrs["units"], ds.attrs["description"] = COORDS[aux]
+            ds.dims[0].attach_scale(scales["depth_interval"])
     for d in derived.values():
         for name, values, text in ((d.name, d.value, d.description),
                                    (d.name + "_stderr", d.stderr,
