@@ -50,6 +50,19 @@ def test_the_model_s_formulas_at_its_anchor_points():
     assert case1.spectral_exponent(0.01) == -1.0 and case1.spectral_exponent(5.0) == 0.0
 
 
+@pytest.mark.parametrize("chl, shares", [(0.03, (62, 21, 17)), (0.3, (61, 22, 17)),
+                                         (1.0, (61, 23, 17)), (10.0, (59, 24, 17))])
+def test_the_readme_s_shares_of_absorption_at_440_nm(chl, shares):
+    """Phytoplankton (A_phi Chl^E_phi), detritus (a_p less it) and CDOM, in % of the non-water
+    absorption at 440 nm, as the README's table gives them."""
+    at = np.array([440.0])
+    a_p, a_phi = case1.particle_absorption(chl, at)[0], case1.phytoplankton_absorption(chl, at)[0]
+    cdom = case1.cdom_absorption(chl, at)[0]
+    total = a_p + cdom
+    assert 0.0 < a_phi < a_p
+    assert [round(100 * x / total) for x in (a_phi, a_p - a_phi, cdom)] == list(shares)
+
+
 def test_no_chlorophyll_is_pure_water():
     water = oceanmc.load_config({**scene(0.0, [450.0]), "water": {"layers": [
         {"thickness_m": math.inf, "components": [{"model": "pure_water"}]}]}})

@@ -79,7 +79,7 @@ def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
 
 def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """a_phi = A_phi Chl^E_phi (Bricaud et al. 1998), 400-700 nm: the living part of a_p (for the
-    README's shares and the tests; the model itself uses a_p)."""
+    README's shares of absorption, tests/test_case1.py; the model itself uses a_p)."""
     table = packaged(BRICAUD)
     nodes = table["wavelength_nm"]
     return (np.interp(wavelengths_nm, nodes, table["A_phi"])
