@@ -39,11 +39,12 @@ def test_spectral_summary_names_estimators_and_shows_what_was_asked(spectral_res
     head = " ".join(line for line in text.splitlines() if line.strip().startswith("nm"))
     for column in ("Ed(0+)", "Rrs nadir", "Rrs 180,0", "Rrs 140,135", "Eu(0+)", "Ed(0-)"):
         assert column in head, column
-    # auto: the crossing estimate for a spectral scene, and the summary says so
-    assert "air/Rrs_nadir_crossing" not in spectral_result
-    assert "Rrs nadir: air/Rrs_nadir, the 175-180 deg polar cap's average, crossing estimate" \
-        in text
+    # auto: the cap's local estimate (with the crossing one beside it), and the summary says so
+    assert "air/Rrs_nadir_crossing" in spectral_result
+    assert "Rrs nadir: air/Rrs_nadir, the 175-180 deg polar cap's average, local (next-event) " \
+        "estimate" in " ".join(text.split())
     assert "air/Rrs_local in the exact directions" in " ".join(text.split())
+    assert "heavy-tailed with forward-peaked phase functions" in " ".join(text.split())
     assert "sun_position" in text and "spectrum spectrl2" in text and "sky share" in text
     # the Ed(0+) column is air/Ed, the Rrs 140,135 column air/Rrs_local's second direction
     row = next(line for line in text.splitlines() if line.strip().startswith("550"))
@@ -94,12 +95,23 @@ def test_spectral_summary_with_the_local_nadir_estimate_says_so(tmp_path):
     assert "local (next-event) estimate" in text and "Rrs_nadir_crossing" not in text
 
 
-def test_a_rough_sea_without_the_exact_nadir_is_told_how_to_get_it():
+def test_a_crossing_estimate_says_how_to_get_the_local_one_or_why_not():
+    """Waves of isotropic slopes: the cap's local estimate by default; asked for the crossing
+    one, the summary names the key that gives the local one. Anisotropic waves keep the
+    crossing estimate, and the summary says why (it once advised the exact nadir's local
+    estimate instead, which is heavy-tailed with forward-peaked particles)."""
     scene = dict(SPECTRAL, surface={"model": "cox_munk", "wind_speed_m_s": 5},
-                 tallies={"depths_m": [0]})
+                 tallies={"depths_m": [0]}, photons=800)
+    assert "air/Rrs_nadir_crossing" in oceanmc.simulate(scene, threads=1)
+    scene["tallies"] = {"depths_m": [0], "nadir_estimator": "crossing"}
     text = " ".join(format_summary(oceanmc.simulate(scene, threads=1)).split())
-    assert "crossing estimate (photons leaving through the cap; " \
-        "tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local estimate)" in text
+    assert "crossing estimate (photons leaving through the cap; tallies.nadir_estimator: local " \
+        "gives the cap's local estimate)" in text
+    scene["surface"] = {"model": "cox_munk", "wind_speed_m_s": 5, "wind_direction_deg": 30}
+    scene["tallies"] = {"depths_m": [0]}
+    text = " ".join(format_summary(oceanmc.simulate(scene, threads=1)).split())
+    assert "the cap's local estimate through waves needs isotropic slopes (no " \
+        "wind_direction_deg) of mean square slope <= 0.2)" in text
 
 
 def test_show_prints_the_same_summary(spectral_result, tmp_path, capsys):

@@ -515,27 +515,39 @@ def estimator_lines(result: Result) -> list[str]:
                         + (" (air/Rrs_nadir_crossing: the crossing estimate)"
                            if "air/Rrs_nadir_crossing" in result else ""))
         else:
-            import yaml
-            try:
-                rough = yaml.safe_load(result.config_yaml)["surface"]["model"] == "cox_munk"
-            except (KeyError, TypeError, yaml.YAMLError):
-                rough = False
-            nadir_asked = any(result.coords["direction_theta"][k] == 180.0
-                              for k in local_directions(result))
-            hint = "" if nadir_asked else \
-                "; tallies.local_directions_deg: [[180, 0]] adds the exact nadir's local " \
-                "estimate" if rough else "; tallies.nadir_estimator: local gives the local " \
-                "estimate"
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
-                        f"through the cap{hint})")
+                        f"through the cap{local_nadir_hint(result)})")
     ks = local_directions(result)
     if len(ks):
         which = ", ".join(f"Rrs {direction_label(result, k)}" for k in ks)
         said.append(f"{which}: air/Rrs_local in the exact direction{'s' if len(ks) > 1 else ''} "
                     "(theta, phi of travel, deg) of tallies.local_directions_deg, local "
-                    "(next-event) estimate")
+                    "(next-event) estimate: heavy-tailed with forward-peaked phase functions "
+                    "(Petzold, Fournier-Forand), whose error bars may understate it")
     return [line for text in said
             for line in textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ")]
+
+
+def local_nadir_hint(result: Result) -> str:
+    """What the crossing estimate's summary line adds: how to get the cap's local estimate, or
+    why the scene cannot have it."""
+    import yaml
+    from pydantic import TypeAdapter
+
+    from ..config import Bottom, Surface, bottom_has_mirror
+    from ..config.surface import MAX_CAP_MSS
+    try:
+        scene = yaml.safe_load(result.config_yaml)
+        surface = Surface(**scene["surface"])
+        bottom = TypeAdapter(Bottom).validate_python(scene["bottom"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return ""
+    if bottom_has_mirror(bottom):
+        return "; a mirror bottom has no density for the local estimate"
+    if not surface.cap_lobe_tabulated():
+        return ("; the cap's local estimate through waves needs isotropic slopes (no "
+                f"wind_direction_deg) of mean square slope <= {MAX_CAP_MSS}")
+    return "; tallies.nadir_estimator: local gives the cap's local estimate"
 
 
 def illumination_lines(result: Result) -> list[str]:
