@@ -12,6 +12,8 @@ from .base import _Strict
 CM_MSS = (0.003, 5.12e-3)
 CM_UPWIND = (0.0, 3.16e-3)
 CM_CROSSWIND = (0.003, 1.92e-3)
+# the smallest mean square slope sampled by table by default: Cox & Munk's calm sea (0 m/s)
+TABLE_MIN_MSS = CM_MSS[0]
 # the largest mean square slope through which the nadir cap's local estimate is tabulated
 # (kernel/rough_cap.py; 30 m/s gives 0.157)
 MAX_CAP_MSS = 0.2
@@ -25,8 +27,10 @@ class Surface(_Strict):
     fresnel: schlick swaps in Schlick's approximation, for comparisons only (never exact).
     method (cox_munk): table samples a table of the facet walk's BSDF, built once per (slopes,
     n_water) and cached on disk (scene/surface_table.py; isotropic slopes only); walk follows
-    every photon facet by facet (the reference, several times slower). Default: table, or walk
-    when wind_direction_deg makes the slopes anisotropic."""
+    every photon facet by facet (the reference, several times slower). Default: table, except
+    walk when wind_direction_deg makes the slopes anisotropic or when mean_square_slope is
+    below TABLE_MIN_MSS (a surface that near flat has a total-internal-reflection edge and
+    lobes sharper than the table's incidence nodes, 1.4 deg apart, resolve)."""
     model: Literal["flat", "none", "cox_munk"] = "flat"
     n_water: Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.34
     fresnel: Literal["exact", "schlick"] = "exact"
@@ -74,8 +78,11 @@ class Surface(_Strict):
 
     def tabulated(self) -> bool:
         """Whether the rough surface is sampled from its table (else by its facet walk)."""
-        return self.model == "cox_munk" and (self.method or (
-            "walk" if self.wind_direction_deg is not None else "table")) == "table"
+        if self.model != "cox_munk":
+            return False
+        if self.method is not None:
+            return self.method == "table"
+        return self.wind_direction_deg is None and sum(self.slope_variances()) >= TABLE_MIN_MSS
 
     def slope_variances(self) -> tuple[float, float]:
         """(upwind, crosswind) slope variances; isotropic: half the mean square slope each."""

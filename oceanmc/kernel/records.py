@@ -78,9 +78,11 @@ MEDIUM = _record(
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
 # roughness along the wind and across it (alpha^2 = 2 x slope variance); wind_cos, wind_sin:
-# the wind's azimuth (cox_munk.py)
+# the wind's azimuth (cox_munk.py); tabulated: the rough surface is sampled from its table
+# (cox_munk_table.py: TABLE_SIZE floats at `table` in the float pool), else by its facet walk
 SURFACE = _record("model", "n_water", "schlick", "delta", "alpha_u", "alpha_c", "wind_cos",
-                  "wind_sin", ints=("model", "schlick", "delta"))
+                  "wind_sin", "tabulated", ints=("model", "schlick", "delta", "tabulated"),
+                  floats_at=("table",))
 
 # The bottom (kernel/brdf/): model id; params: its parameters (scene/brdf_tables.py layout,
 # whose offsets are relative to params) in the float pool.

@@ -90,12 +90,13 @@ def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
 
 
 @internal
-def facet_walk(surface, p, rng):
-    """The rough surface in split()'s form: one sample of its facet walk (weight f cos / pdf
-    applied to p.w), as R = 1 into the reflected direction or R = 0 into the transmitted one,
-    so that the delta surface's expected-value scoring applies to it unchanged."""
+def facet_walk(surface, floats, p, rng):
+    """The rough surface in split()'s form: one sample of it (its table or its facet walk;
+    weight f cos / pdf applied to p.w), as R = 1 into the reflected direction or R = 0 into the
+    transmitted one, so that the delta surface's expected-value scoring applies to it
+    unchanged."""
     ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, p.ux, p.uy, p.uz,
-                                                          uniform(rng), rng)
+                                                          uniform(rng), rng, floats)
     p.w *= weight
     return (0.0 if transmitted else 1.0), ox, oy, oz, ox, oy, oz
 
@@ -111,7 +112,7 @@ def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
         w = p.w
     if ctrl.analog:
         reflected = r > 0.0 and uniform(rng) < r
@@ -243,7 +244,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
     w = p.w
     if ctrl.analog:
         goes_on = r > 0.0 and uniform(rng) < r

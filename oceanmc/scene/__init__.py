@@ -72,8 +72,9 @@ def build(config: cfg.SceneConfig) -> Scene:
                                    len(directions[0]), len(column.albedo))
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     no_ints = np.zeros(0, dtype=np.int64)
-    (med, bot, sk, gr, est), floats, ints = merge(
-        [(med, mf, mi), (bot, bp, no_ints), (sk, sf, no_ints), (gr, gf, gi), (est, ef, ei)])
+    (med, bot, sk, gr, est, surf), floats, ints = merge(
+        [(med, mf, mi), (bot, bp, no_ints), (sk, sf, no_ints), (gr, gf, gi), (est, ef, ei),
+         (surf, surface.pool(config.surface, surf), no_ints)])
     return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column.albedo),
                  floats, ints, angles, local_rows, column.layers)
 

@@ -1,4 +1,5 @@
-"""The air-water surface packer: the SURFACE record (kernel/records.py)."""
+"""The air-water surface packer: the SURFACE record (kernel/records.py) and its float pool (the
+rough surface's table, scene/surface_table.py)."""
 from __future__ import annotations
 
 import math
@@ -8,21 +9,30 @@ import numpy as np
 from .. import config as cfg
 from .. import registry
 from ..kernel.records import SURFACE, record
-from . import sky_maps
+from . import sky_maps, surface_table
 
 
 def pack(surface: cfg.Surface, n_water: float) -> np.ndarray:
+    """The SURFACE record; a tabulated rough surface's table is at offset 0 of pool()'s."""
     if surface.model != "cox_munk":
         return record(SURFACE, model=registry.surface_id(surface.model), n_water=float(n_water),
                       schlick=int(surface.fresnel == "schlick"), delta=1, alpha_u=0.0,
-                      alpha_c=0.0, wind_cos=1.0, wind_sin=0.0)
+                      alpha_c=0.0, wind_cos=1.0, wind_sin=0.0, tabulated=0, table=0)
     upwind, crosswind = surface.slope_variances()
     azimuth = math.radians(surface.wind_direction_deg or 0.0)
     # Beckmann's alpha^2 is twice a slope component's variance (p ~ exp(-z^2 / alpha^2))
     return record(SURFACE, model=registry.surface_id(surface.model), n_water=float(n_water),
                   schlick=0, delta=0, alpha_u=math.sqrt(2.0 * upwind),
                   alpha_c=math.sqrt(2.0 * crosswind), wind_cos=math.cos(azimuth),
-                  wind_sin=math.sin(azimuth))
+                  wind_sin=math.sin(azimuth), tabulated=int(surface.tabulated()), table=0)
+
+
+def pool(surface: cfg.Surface, packed: np.ndarray) -> np.ndarray:
+    """The record's float pool: the table of a tabulated rough surface (from the disk cache,
+    or built), else empty."""
+    if not packed[0]["tabulated"]:
+        return np.zeros(0)
+    return surface_table.table(float(packed[0]["alpha_u"]), float(packed[0]["n_water"]))
 
 
 # walks per batch and view direction for the reflected-radiance estimates (a few ms each)

@@ -100,9 +100,10 @@ def projected_slope(a, u):
 
 
 @kernel
-def visible_normal(alpha_u, alpha_c, vx, vy, vz, rng):
+def visible_normal(alpha_u, alpha_c, vx, vy, vz, u1, u2, u3):
     """A facet normal (z > 0) drawn from the distribution of normals visible from direction
-    (vx, vy, vz), vz > 0 (Heitz & d'Eon 2014, section 4: stretch, draw, rotate, unstretch)."""
+    (vx, vy, vz), vz > 0 (Heitz & d'Eon 2014, section 4: stretch, draw, rotate, unstretch), by
+    the uniform draws u1 (the slope along the view azimuth), u2 and u3 (the one across it)."""
     sx = alpha_u * vx
     sy = alpha_c * vy
     sin_t = math.sqrt(sx * sx + sy * sy)
@@ -112,13 +113,68 @@ def visible_normal(alpha_u, alpha_c, vx, vy, vz, rng):
         a = SQRT2 * vz / sin_t
     else:
         cos_p, sin_p, a = 1.0, 0.0, math.inf
-    along = projected_slope(a, uniform(rng)) / SQRT2
+    along = projected_slope(a, u1) / SQRT2
     # the slope across the view azimuth is N(0, 1/2) (Box-Muller)
-    across = math.sqrt(-math.log(1.0 - uniform(rng))) * math.cos(2.0 * math.pi * uniform(rng))
+    across = math.sqrt(-math.log(1.0 - u2)) * math.cos(2.0 * math.pi * u3)
     slope_u = alpha_u * (cos_p * along - sin_p * across)
     slope_c = alpha_c * (sin_p * along + cos_p * across)
     norm = 1.0 / math.sqrt(1.0 + slope_u * slope_u + slope_c * slope_c)
     return -slope_u * norm, -slope_c * norm, norm
+
+
+@kernel
+def facet(au, ac, n_incident, n_other, x, y, z, side, u1, u2, u3):
+    """(mx, my, mz, cos_i, r, cos_t, ratio): the facet that a ray on side `side` travelling
+    (x, y, z) (the walk's frame) meets, drawn from the visible normals by u1, u2, u3: its
+    normal, the incidence cosine on it, its Fresnel reflectance, the refracted cosine and
+    n1/n2."""
+    mx, my, mz = visible_normal(au, ac, -x, -y, -side * z, u1, u2, u3)
+    mz *= side
+    cos_i = -(x * mx + y * my + z * mz)
+    n1, n2 = (n_incident, n_other) if side > 0.0 else (n_other, n_incident)
+    r, cos_t = fresnel(n1, n2, cos_i)
+    return mx, my, mz, cos_i, r, cos_t, n1 / n2
+
+
+@kernel
+def leave_facet(x, y, z, mx, my, mz, cos_i, cos_t, ratio, reflected):
+    """The unit direction of a ray (x, y, z) after the facet of normal m: mirrored, or
+    refracted by Snell's law (ratio = n1/n2, cos_t the refracted cosine)."""
+    if reflected:
+        x += 2.0 * cos_i * mx
+        y += 2.0 * cos_i * my
+        z += 2.0 * cos_i * mz
+    else:
+        k = ratio * cos_i - cos_t
+        x = ratio * x + k * mx
+        y = ratio * y + k * my
+        z = ratio * z + k * mz
+    norm = 1.0 / math.sqrt(x * x + y * y + z * z)
+    return x * norm, y * norm, z * norm
+
+
+@kernel
+def wander(au, ac, n_incident, n_other, x, y, z, h, side, start, u, rng):
+    """(x, y, z, side): where a ray at height h on side `side` travelling (x, y, z) leaves the
+    microsurface, reflected or refracted at every facet it meets with the Fresnel probability,
+    counting its interactions from `start` (the facets already met). u is the draw of the next
+    height, rng the stream for the others."""
+    for interaction in range(start, MAX_INTERACTIONS):
+        h_side = next_height(au, ac, side * h, x, y, side * z,
+                             u if interaction == start else uniform(rng))
+        if h_side == ESCAPED:
+            break
+        h = side * h_side
+        mx, my, mz, cos_i, r, cos_t, ratio = facet(au, ac, n_incident, n_other, x, y, z, side,
+                                                   uniform(rng), uniform(rng), uniform(rng))
+        reflected = uniform(rng) < r
+        x, y, z = leave_facet(x, y, z, mx, my, mz, cos_i, cos_t, ratio, reflected)
+        if not reflected:
+            side = -side
+    else:
+        if side * z < 0.0:
+            z = -z
+    return x, y, z, side
 
 
 @kernel
@@ -128,45 +184,13 @@ def walk(surface, ux, uy, uz, u, rng):
     (back to its side) or transmitted, after every facet it meets. u is the first draw (the
     height of the first facet met), rng the stream for the others."""
     n = surface.n_water
-    au, ac = surface.alpha_u, surface.alpha_c
     wc, ws = surface.wind_cos, surface.wind_sin
     from_air = uz > 0.0
     n_incident = 1.0 if from_air else n
     n_other = n if from_air else 1.0
-    x = ux * wc + uy * ws
-    y = -ux * ws + uy * wc
-    z = -abs(uz)
-    side = 1.0
-    h = ESCAPED
-    for interaction in range(MAX_INTERACTIONS):
-        h_side = next_height(au, ac, side * h, x, y, side * z,
-                             u if interaction == 0 else uniform(rng))
-        if h_side == ESCAPED:
-            break
-        h = side * h_side
-        mx, my, mz = visible_normal(au, ac, -x, -y, -side * z, rng)
-        mz *= side
-        cos_i = -(x * mx + y * my + z * mz)
-        n1, n2 = (n_incident, n_other) if side > 0.0 else (n_other, n_incident)
-        r, cos_t = fresnel(n1, n2, cos_i)
-        if uniform(rng) < r:
-            x += 2.0 * cos_i * mx
-            y += 2.0 * cos_i * my
-            z += 2.0 * cos_i * mz
-        else:
-            ratio = n1 / n2
-            k = ratio * cos_i - cos_t
-            x = ratio * x + k * mx
-            y = ratio * y + k * my
-            z = ratio * z + k * mz
-            side = -side
-        norm = 1.0 / math.sqrt(x * x + y * y + z * z)
-        x *= norm
-        y *= norm
-        z *= norm
-    else:
-        if side * z < 0.0:
-            z = -z
+    x, y, z, side = wander(surface.alpha_u, surface.alpha_c, n_incident, n_other,
+                           ux * wc + uy * ws, -ux * ws + uy * wc, -abs(uz), ESCAPED, 1.0, 0, u,
+                           rng)
     oz = -z if from_air else z
     return x * wc - y * ws, x * ws + y * wc, oz, side < 0.0
 

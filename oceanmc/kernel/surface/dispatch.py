@@ -5,15 +5,16 @@ so, as in Mitsuba 3 and pbrt-v4, evaluate() and pdf() are 0 for every finite pai
 and the light is carried by sample(), which returns the direction and the weight f cos / pdf:
 choosing reflection with probability R, each branch's weight is 1. The photon loop's implicit
 estimator uses split() for them instead (surface.delta), the expected-value form of the same
-BSDF: both branches with their shares R and 1 - R. The rough surface (cox_munk.py) is sampled
-only, by its facet walk, with weight 1. Local estimates through a delta surface ask for
+BSDF: both branches with their shares R and 1 - R. The rough surface is sampled only, with
+weight 1: from its table (cox_munk_table.py, surface.tabulated) where the caller passes the
+scene's float pool, else by its facet walk (cox_munk.py). Local estimates through a delta surface ask for
 transmittance(); through the rough one they sample the walk backwards (local_estimate.py)."""
 import numpy as np
 
 from ..compile import kernel, setup
 from ..models import SURFACE_COX_MUNK, SURFACE_FLAT
 from ..rng import uniform
-from . import cox_munk, flat, index_matched
+from . import cox_munk, cox_munk_table, flat, index_matched
 
 
 @kernel
@@ -27,11 +28,18 @@ def split(surface, ux, uy, uz):
 
 
 @kernel
-def sample(surface, ux, uy, uz, u, rng):
+def sample(surface, ux, uy, uz, u, rng, floats=None):
     """(ox, oy, oz, weight, transmitted): the direction the photon leaves in and the weight
     f cos / pdf, 1 for every model. u is the first uniform draw (a delta surface reflects when
-    u < R), rng the stream for any further ones (the rough surface's walk)."""
+    u < R), rng the stream for any further ones (the rough surface's). floats: the scene's
+    float pool, which holds a tabulated rough surface's table; without it (None: Numba
+    compiles that call without the table's branch) the rough surface walks."""
     if surface.model == SURFACE_COX_MUNK:
+        if floats is not None:
+            if surface.tabulated:
+                ox, oy, oz, transmitted = cox_munk_table.sample(surface, floats, ux, uy, uz,
+                                                                u, rng)
+                return ox, oy, oz, 1.0, transmitted
         ox, oy, oz, transmitted = cox_munk.walk(surface, ux, uy, uz, u, rng)
         return ox, oy, oz, 1.0, transmitted
     r, rx, ry, rz, tx, ty, tz = split(surface, ux, uy, uz)
