@@ -75,7 +75,8 @@ def templates(folder):
                  "concentration": 1.0},
                 {"model": "table", "file": f["iops.csv"]},
                 {"model": "chlorophyll", "chl_mg_m3": {"profile": "table",
-                                                       "file": f["profile.csv"]}}]}]},
+                                                       "file": f["profile.csv"]}},
+                {"model": "case1", "chl_mg_m3": 0.3}]}]},
             bottom={"model": "minnaert", "reflectance": 0.2, "k": 0.5}, tallies=SMALL_TALLIES),
         "sun_spectrl2": _mono(   # pvlib's solar position: 80 ms a load
             wavelengths_nm=[400, 600], tallies=SMALL_TALLIES,
