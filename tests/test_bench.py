@@ -78,18 +78,25 @@ def test_upward_bias_gains_quoted_are_the_committed_bench():
 
 
 def test_surface_section_reports_rough_over_flat_ratios():
-    """The rough-sea section's table: speed and FOM ratios are rough / flat of the measured
-    numbers (a swapped or inverted ratio fails)."""
+    """The rough-sea section's tables: speed and FOM ratios are each surface's over the flat
+    one's, and the table's speed over the walk's (a swapped or inverted ratio fails)."""
     from oceanmc.bench import surface
 
+    def fom_row(seconds, value, fom):
+        return {"seconds": seconds, "quantities": {"Rrs": {"value": value, "fom": fom}}}
     data = {"photons": 10, "repeats": 1, "fom_photons": 10,
-            "speed": {"flat": {"photons_per_s_1t": 4.0e6}, "rough": {"photons_per_s_1t": 1.0e6}},
-            "fom": {"flat": {"seconds": 1.0, "quantities": {"Rrs": {"value": 0.006, "fom": 100.0}}},
-                    "rough": {"seconds": 2.0,
-                              "quantities": {"Rrs": {"value": 0.0065, "fom": 30.0}}}}}
+            "speed": {"flat": {"photons_per_s_1t": 4.0e6},
+                      "rough, walk": {"photons_per_s_1t": 0.5e6},
+                      "rough, table": {"photons_per_s_1t": 3.0e6}},
+            "table_build": {"miss_s": 1.25, "hit_s": 0.002, "load_average": 2.0},
+            "fom": {"flat": fom_row(1.0, 0.006, 100.0), "rough, walk": fom_row(5.0, 0.0065, 20.0),
+                    "rough, table": fom_row(2.0, 0.0065, 60.0)}}
     text = "\n".join(surface.report_lines(data))
-    assert "| rough | 1,000,000 | 0.25 |" in text
-    assert "| Rrs | 0.00600 | 0.00650 | 100 | 30 | 0.30 |" in text
+    assert "| rough, walk | 500,000 | 0.12 |" in text
+    assert "| rough, table | 3,000,000 | 0.75 |" in text
+    assert "6.0x as fast as the walk" in text
+    assert "cache miss: 1.25 s" in text and "hit: 2.0 ms" in text
+    assert "| Rrs | 0.00600 | 0.00650 | 0.00650 | 100 | 20 | 60 | 0.20 | 0.60 |" in text
 
 
 def test_spectral_section_splits_the_worst_band_into_time_and_variance():
