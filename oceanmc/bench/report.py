@@ -105,8 +105,9 @@ def write_speed_report(out_dir: Path, data: dict) -> None:
     (out_dir / "speed.json").write_text(json.dumps(data, indent=1))
     lines = ["# oceanmc benchmark: speed and start-up", "",
              f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
-             f"numba {data['numba']}. Regenerate with `oceanmc bench --speed -o DIR` (the full "
-             "`oceanmc bench` has these sections in bench.md).", ""]
+             f"numba {data['numba']}; kernel commit {kernel_commit()}. Regenerate with "
+             "`oceanmc bench --speed -o DIR` (the full `oceanmc bench` has these sections in "
+             "bench.md).", ""]
     (out_dir / "speed.md").write_text("\n".join(lines + speed_lines(data)) + "\n")
 
 
@@ -116,7 +117,8 @@ def write_report(out_dir: Path, data: dict) -> None:
     plot(data["error_vs_time"], out_dir / "error_vs_time.png")
     lines = ["# oceanmc benchmark", "",
              f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
-             f"numba {data['numba']}. Regenerate with `oceanmc bench -o {out_dir}`.", ""]
+             f"numba {data['numba']}; kernel commit {kernel_commit()}. Regenerate with "
+             f"`oceanmc bench -o {out_dir}`.", ""]
     lines += speed_lines(data)
     lines += ["", "## Error against run time", "",
               "FOM = 1 / (relative standard error^2 x wall time), median over the photon "

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..run.simulation import simulate
+from .report import kernel_commit
 
 WAVELENGTHS = {"start": 400.0, "stop": 700.0, "step": 10.0}
 CHLOROPHYLL = (0.1, 1.0, 10.0)
@@ -165,7 +166,8 @@ def main(out_dir: Path, quick: bool) -> int:
     (out_dir / "spectral.md").write_text("\n".join(
         ["# oceanmc benchmark: spectral section", "",
          f"Regenerate with `oceanmc bench --spectral{' --quick' if quick else ''} -o "
-         f"{out_dir}` (the full `oceanmc bench` includes it in bench.md).", ""]
+         f"{out_dir}` (the full `oceanmc bench` includes it in bench.md). Kernel commit "
+         f"{kernel_commit()}.", ""]
         + report_lines(data)))
     print(f"wrote {out_dir / 'spectral.md'}")
     return 0

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .report import kernel_commit
+
 A_VALUES = [round(float(a), 4) for a in np.geomspace(0.02, 0.5, 10)]
 BOTTOM_DEPTHS_M = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 15.0, 20.0]
 
@@ -115,7 +117,8 @@ def report(data: dict) -> str:
         "# Sweep benchmark",
         "",
         f"Produced by `oceanmc bench --sweep` ({data['date']}, oceanmc {data['version']}, numba "
-        f"{data['numba']}; {data['machine']}; load average {data['load_before']:.2f} before, "
+        f"{data['numba']}; kernel commit {kernel_commit()}; {data['machine']}; load average "
+        f"{data['load_before']:.2f} before, "
         f"{data['load_after']:.2f} after{'; --quick' if data['quick'] else ''}).",
         "",
         f"A {n}-point look-up table: Rrs at nadir (local estimate) over 10 absorption "
