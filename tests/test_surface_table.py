@@ -68,19 +68,23 @@ def table_reflectance(table, theta_deg, from_air):
     return (1.0 - f) * table[at] + f * table[at + 1]
 
 
-def table_reflectance_stderr(alpha, theta_deg, from_air, seed, batches=20):
-    """The standard error of a table's R at an incidence: WALKS_PER_NODE table walks
-    (cox_munk_table.walk_node) in 20 batches, the batch means' standard error."""
-    walks = surface_table.WALKS_PER_NODE // batches
+def table_reflectance_stderr(alpha, theta_deg, from_air, seed, replicates=8):
+    """The standard error of a table's R at an incidence: the spread of R over independent
+    tables' worth of walks at that incidence (WALKS_PER_NODE walks of cox_munk_table.walk_node
+    each, Latin hypercube strata as the builder draws them)."""
+    walks = surface_table.WALKS_PER_NODE
     n1, n2 = (1.0, N_WATER) if from_air else (N_WATER, 1.0)
     branch, t, s, w = (np.empty(2 * walks, dtype=np.int64), np.empty(2 * walks),
                        np.empty(2 * walks), np.empty(2 * walks))
-    means = []
-    for b in range(batches):
+    values = []
+    for b in range(replicates):
+        stream = batch_state(seed, b)
+        permutations = np.random.default_rng(stream)
+        strata = np.stack([permutations.permutation(walks) for _ in range(3)])
         count = layout.walk_node(alpha, n1, n2, math.cos(math.radians(theta_deg)), walks,
-                                 batch_state(seed, b), branch, t, s, w)
-        means.append(w[:count][branch[:count] == layout.REFLECTED].sum() / walks)
-    return float(np.std(means, ddof=1) / math.sqrt(batches))
+                                 strata, stream, branch, t, s, w)
+        values.append(w[:count][branch[:count] == layout.REFLECTED].sum() / walks)
+    return float(np.std(values, ddof=1))
 
 
 def test_refined_cells_have_the_levels_probabilities():
@@ -118,8 +122,8 @@ def test_energy_closure_and_directions(seven):
 @pytest.mark.parametrize("from_air", [True, False])
 def test_reflectance_per_angle_matches_the_walk(seven, from_air):
     """R of the table at each incidence against the walk's fraction reflected in 200,000 walks:
-    |z| < 4, the standard error the walk's binomial one and the table's own (the spread of a
-    table's R from WALKS_PER_NODE walks, table_reflectance_stderr). From the water this covers total
+    |z| < 4, the standard error the walk's binomial one and the table's own (the spread of R
+    over 8 tables' worth of walks, table_reflectance_stderr). From the water this covers total
     internal reflection (47-85 deg)."""
     surface, table = seven
     alpha = float(surface["alpha_u"])

@@ -53,7 +53,8 @@ def table_build_times(n_water: float) -> dict:
     alpha = math.sqrt(2.0 * Surface(model="cox_munk",
                                     wind_speed_m_s=WIND_M_S).slope_variances()[0])
     # one walk: compiles the builder, or loads it from the compile cache, outside the timing
-    cox_munk_table.walk_node(alpha, 1.0, n_water, 0.5, 1, batch_state(0, 0),
+    cox_munk_table.walk_node(alpha, 1.0, n_water, 0.5, 1, np.zeros((3, 1), dtype=np.int64),
+                             batch_state(0, 0),
                              np.empty(2, dtype=np.int64), np.empty(2), np.empty(2), np.empty(2))
     kept = surface_table.TABLE_DIR
     with tempfile.TemporaryDirectory() as folder:

@@ -2,12 +2,12 @@
 once per (slope alpha, n_water), kept on disk beside the compile cache.
 
 Build: at each of the NODES incidences per side, WALKS_PER_NODE walks split at their first
-facet (cox_munk_table.walk_node: 2 weighted leaving directions a walk), in threads (the walks
-release the GIL); R is the reflected weight over the walks, and each branch's quantiles are the
+facet, their first facets drawn by Latin hypercube sampling (cox_munk_table.walk_node: 2
+weighted leaving directions a walk), in threads (the walks release the GIL); R is the reflected weight over the walks, and each branch's quantiles are the
 weighted empirical quantiles of its leaving directions (the value where the cumulative weight,
 counted to the middle of each sample, reaches the level; linear between samples, the extreme
-samples at levels 0 and 1). Each node has its own random stream from (TABLE_SEED, side, node),
-so a table is the same whatever the number of threads.
+samples at levels 0 and 1). Each node has its own random stream and permutations from
+(TABLE_SEED, side, node), so a table is the same whatever the number of threads.
 
 Cache: CACHE_DIR's parent / surface_tables / cox_munk-<sources>-<key>.npy, <sources> a hash of
 the walk's and the table's kernel sources (an edit there makes new tables), <key> a hash of
@@ -32,7 +32,9 @@ FORMAT_VERSION = 1
 WALKS_PER_NODE = 20_000
 TABLE_SEED = 20_161_126
 TABLE_DIR = CACHE_DIR.parent / "surface_tables"
-_SOURCES = ("cox_munk.py", "cox_munk_table.py", "fresnel.py")
+# the sources a table depends on: the walk, the table's layout and sampler, this builder
+_SOURCES = ("kernel/surface/cox_munk.py", "kernel/surface/cox_munk_table.py",
+            "kernel/surface/fresnel.py", "kernel/rng.py", "scene/surface_table.py")
 
 
 def edge_levels(n: int) -> np.ndarray:
@@ -52,9 +54,9 @@ AZIMUTH_LEVELS = edge_levels(layout.AZIMUTH_BINS)
 
 def _sources_hash() -> str:
     digest = hashlib.sha256()
-    folder = Path(layout.__file__).parent
-    for name in _SOURCES + ("../rng.py",):
-        digest.update((folder / name).read_bytes())
+    package = Path(__file__).parents[1]
+    for name in _SOURCES:
+        digest.update((package / name).read_bytes())
     return digest.hexdigest()[:12]
 
 
@@ -151,9 +153,11 @@ def _node(alpha: float, n_water: float, side: int, node: int) -> tuple[float, np
     size = 2 * WALKS_PER_NODE
     branch = np.empty(size, dtype=np.int64)
     t, az, w = np.empty(size), np.empty(size), np.empty(size)
-    count = layout.walk_node(alpha, n_incident, n_other, mu, WALKS_PER_NODE,
-                             batch_state(TABLE_SEED, side * layout.NODES + node), branch, t, az,
-                             w)
+    stream = batch_state(TABLE_SEED, side * layout.NODES + node)
+    permutations = np.random.default_rng(stream)
+    strata = np.stack([permutations.permutation(WALKS_PER_NODE) for _ in range(3)])
+    count = layout.walk_node(alpha, n_incident, n_other, mu, WALKS_PER_NODE, strata, stream,
+                             branch, t, az, w)
     branch, t, az, w = branch[:count], t[:count], az[:count], w[:count]
     reflected = branch == layout.REFLECTED
     r = float(w[reflected].sum() / WALKS_PER_NODE)

@@ -124,26 +124,35 @@ def sample(surface, floats, ux, uy, uz, u, rng):
 
 
 @batch
-def walk_node(alpha, n_incident, n_other, mu, walks, rng, branch, t_out, s_out, weight_out):
+def walk_node(alpha, n_incident, n_other, mu, walks, strata, rng, branch, t_out, s_out,
+              weight_out):
     """The leaving directions of `walks` walks of light travelling at incidence cosine mu into
     an isotropic surface (Beckmann alpha) from the medium of index n_incident, in the table's
     coordinates (t_o = sqrt(1 - mu_o), s = tan(dphi / 4), dphi in [0, pi] the azimuth from
-    the incident plane, branch 0
-    reflected, 1 transmitted), with weights; returns how many were written (at most 2 walks).
+    the incident plane, branch 0 reflected, 1 transmitted), with weights; returns how many
+    were written (at most 2 a walk).
 
     Each walk splits once, at the first facet (expected-value splitting; Kalos & Whitlock,
     Monte Carlo Methods, 2008, 4.3): it goes on both reflected, with weight R_facet, and
     refracted, with weight 1 - R_facet, each continuation a walk of its own (cox_munk.wander).
     The weights of a walk add up to 1, so the table's R is an unbiased estimate of the walk's
     with far less noise: most of R's variance is the first facet's choice (near normal
-    incidence from the air, R = 0.02 would otherwise rest on 2% of the walks)."""
+    incidence from the air, R = 0.02 would otherwise rest on 2% of the walks). The first
+    facets are drawn by Latin hypercube sampling (McKay, Beckman & Conover 1979,
+    Technometrics 21, 239): walk i draws its facet's three uniforms in strata[d, i] of `walks`
+    equal strata (strata[d] a random permutation of 0 .. walks - 1), so each of the three
+    is spread evenly over the walks; unbiased, and measured on two tables of different seeds
+    at 7 m/s, the light in 10 x 15 deg quads differed by 0.1-0.7% instead of 1.2-1.4% at 30
+    and 60 deg incidence (2.8% -> 1.9% at normal incidence, where the azimuth is uniform).
+    The rest of each walk draws from rng."""
     x0 = math.sqrt(max(0.0, 1.0 - mu * mu))
     count = 0
-    for _ in range(walks):
+    for i in range(walks):
         h = next_height(alpha, alpha, ESCAPED, x0, 0.0, -mu, uniform(rng))
         mx, my, mz, cos_i, r, cos_t, ratio = facet(
-            alpha, alpha, n_incident, n_other, x0, 0.0, -mu, 1.0, uniform(rng), uniform(rng),
-            uniform(rng))
+            alpha, alpha, n_incident, n_other, x0, 0.0, -mu, 1.0,
+            (strata[0, i] + uniform(rng)) / walks, (strata[1, i] + uniform(rng)) / walks,
+            (strata[2, i] + uniform(rng)) / walks)
         for reflected in (True, False):
             weight = r if reflected else 1.0 - r
             if weight <= 0.0:
