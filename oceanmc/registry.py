@@ -53,6 +53,9 @@ BOTTOM = {
     "ggx": (models.BOTTOM_GGX, "ggx"),
     "hapke": (models.BOTTOM_HAPKE, "hapke"),
     "table": (models.BOTTOM_TABLE, "table"),
+    # an areal mixture of one shape: packed as the lambertian or minnaert bottom of the
+    # fraction-weighted reflectance (optics/bottom.py), no kernel model of its own
+    "mixture": (None, None),
 }
 
 # Air-water surfaces: schema model -> (kernel model id, module in kernel/surface/)

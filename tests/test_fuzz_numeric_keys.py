@@ -52,12 +52,14 @@ def templates(folder):
     (folder / "spectrum.csv").write_text("wavelength_nm,Ed0,diffuse_fraction\n350,1,0.2\n"
                                          "800,1.5,0.1\n")
     (folder / "phase.csv").write_text("0,10\n10,1\n90,0.1\n180,0.1\n")
+    (folder / "bottom.csv").write_text("wavelength_nm,reflectance\n350,0.05\n800,0.2\n")
     angles = np.arange(0.0, 90.1, 10.0)
     np.savez(folder / "brdf.npz", theta_i_deg=angles, theta_r_deg=angles,
              phi_deg=np.arange(0.0, 180.1, 30.0), brdf=np.full((10, 10, 7), 0.3 / np.pi))
     np.save(folder / "sky.npy", np.ones((9, 36)))
     f = {name: str(folder / name) for name in ("iops.csv", "profile.csv", "spectrum.csv",
-                                                  "phase.csv", "brdf.npz", "sky.npy")}
+                                                  "phase.csv", "brdf.npz", "sky.npy",
+                                                  "bottom.csv")}
     return {
         "hg_lambertian": _mono(),
         "constituents_minnaert": _mono(
@@ -125,6 +127,12 @@ def templates(folder):
                       bottom={"model": "none"}, tallies=SMALL_TALLIES),
         "specular": _mono(bottom={"model": "specular", "reflectance": 0.5},
                           tallies=SMALL_TALLIES),
+        "bottom_mixture_spectra": _mono(
+            wavelengths_nm=[400, 500, 600], tallies=SMALL_TALLIES,
+            bottom={"model": "mixture", "components": [
+                {"model": "lambertian", "fraction": 0.6, "reflectance": [0.05, 0.3, 0.15]},
+                {"model": "lambertian", "fraction": 0.4,
+                 "reflectance": {"file": f["bottom.csv"]}}]}),
     }
 
 
@@ -284,7 +292,7 @@ def test_every_numeric_key_of_the_schema_is_reached(scenes):
 FUZZED: set = set()
 TEMPLATES = ["hg_lambertian", "constituents_minnaert", "sun_spectrl2", "lists_cox_munk_wind",
              "ggx", "ff_hapke_slope", "mixture_lambertian_specular", "files", "deep",
-             "specular"]
+             "specular", "bottom_mixture_spectra"]
 
 
 @pytest.mark.parametrize("template", TEMPLATES)

@@ -1,6 +1,6 @@
-"""Every table and array file a scene names (issue 29, section 6): the component, profile and
-spectrum tables (optics/tables.py read_table), phase tables and BRDF text tables
-(scene/phase_tables.py numeric_rows), BRDF arrays (.npz, HDF5) and sky maps (.npy, .npz, HDF5,
+"""Every table and array file a scene names (issue 29, section 6): the component, profile,
+spectrum and bottom reflectance tables (optics/tables.py read_table), phase tables and BRDF
+text tables (scene/phase_tables.py numeric_rows), BRDF arrays (.npz, HDF5) and sky maps (.npy, .npz, HDF5,
 .exr), each with NaN, +-inf, 1e308, 1e-308, -1 and 0 in the first and last entry of every
 column or array, and empty files, a header only, wrong column counts, duplicate columns,
 non-numeric cells, a decreasing first column, text, complex, boolean, empty and misshapen
@@ -18,6 +18,7 @@ import pytest
 
 import oceanmc
 from oceanmc.config import ConfigError, data_file_hashes, load_config
+from oceanmc.optics.bottom import COLUMNS as BOTTOM_COLUMNS
 from oceanmc.optics.components.table import COLUMNS
 from oceanmc.optics.illumination import TABLE_COLUMNS
 
@@ -53,6 +54,10 @@ def spectrum_table(path):
                                   "spectrum": {"model": "table", "file": path}})
 
 
+def bottom_spectrum(path):
+    return dict(spectral(), bottom={"model": "lambertian", "reflectance": {"file": path}})
+
+
 def phase_table(path):
     scene = copy.deepcopy(BASE)
     scene["water"]["layers"][0]["phase"] = {"model": "table", "file": path}
@@ -77,6 +82,8 @@ TEXT_TABLES = {
     "profile table": ("depth_m,value", [[0, 0.5], [1, 1.0], [5, 1.5]], profile_table),
     "spectrum table": ("wavelength_nm,Ed0,diffuse_fraction",
                        [[350, 1, 0.2], [500, 1.2, 0.15], [800, 1.5, 0.1]], spectrum_table),
+    "bottom spectrum table": ("wavelength_nm,reflectance", [[350, 0.05], [500, 0.3], [800, 0.1]],
+                              bottom_spectrum),
     "phase table": ("angle_deg,value", [[0, 10], [10, 1], [90, 0.1], [180, 0.1]], phase_table),
     "brdf text table": ("theta_i,theta_r,phi,f",
                         [[ti, tr, p, 0.3 / math.pi] for ti in (0, 45, 90) for tr in (0, 45, 90)
@@ -92,6 +99,7 @@ def _text(header, rows):
 
 # the columns' allowed ranges (optics/tables.py read_table checks them): their edges are tried
 RANGES = {"component table": COLUMNS, "spectrum table": TABLE_COLUMNS,
+          "bottom spectrum table": BOTTOM_COLUMNS,
           "profile table": {"depth_m": (0.0, 1e6, "m"), "value": (0.0, 100.0, "mg/m3")}}
 # edge values whose run fails for a reason outside the readers (none now: b = 1e6 1/m at one
 # wavelength gave the spectral walk's NaN, fixed in kernel/spectral.py)
@@ -296,8 +304,8 @@ def test_a_table_edited_between_two_runs_is_read_anew(tmp_path):
     refused(config, path, "a = nan at wavelength_nm = 350")
 
 
-@pytest.mark.parametrize("place", [component_table, profile_table, spectrum_table, phase_table,
-                                   brdf_table, sky_map])
+@pytest.mark.parametrize("place", [component_table, profile_table, spectrum_table,
+                                   bottom_spectrum, phase_table, brdf_table, sky_map])
 def test_a_fifo_a_device_or_a_folder_is_refused_without_being_read(tmp_path, place):
     """A component, profile or spectrum table that was a FIFO blocked for ever, /dev/zero was
     read until the memory ran out (data_file_hashes read them first, for every kind of file);

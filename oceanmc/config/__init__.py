@@ -9,9 +9,10 @@ illumination, surface, bottom, tallies, estimator, scene (SceneConfig and the ch
 components); loading (load_config, config_to_yaml). Every name is re-exported here.
 """
 from .base import Asymmetry, ConfigError, Finite, Fraction, NonNegative, _Strict
-from .bottom import (BlackBottom, Bottom, GGXBottom, HapkeBottom, LambertianBottom,
-                     LambertianSpecularBottom, MinnaertBottom, NoBottom, Sampling, SpecularBottom,
-                     TableBottom, bottom_has_mirror, bottom_weight_bounded)
+from .bottom import (BlackBottom, Bottom, BottomComponent, GGXBottom, HapkeBottom,
+                     LambertianBottom, LambertianSpecularBottom, MinnaertBottom, MixtureBottom,
+                     NoBottom, ReflectanceSpectrum, Sampling, SpecularBottom, TableBottom,
+                     bottom_has_mirror, bottom_weight_bounded)
 from .components import (Case1Component, CdomComponent, ChlorophyllComponent, Component,
                          ConstantComponent, GaussianProfile, LinearProfile, ParticlesComponent,
                          Profile, PureWaterComponent, TableComponent, TableProfile)
@@ -41,7 +42,8 @@ __all__ = [
     "Surface",
     "NoBottom", "BlackBottom", "Sampling", "LambertianBottom", "MinnaertBottom",
     "SpecularBottom", "LambertianSpecularBottom", "GGXBottom", "HapkeBottom", "TableBottom",
-    "Bottom", "bottom_has_mirror", "bottom_weight_bounded",
+    "ReflectanceSpectrum", "BottomComponent", "MixtureBottom", "Bottom", "bottom_has_mirror",
+    "bottom_weight_bounded",
     "HYDROLIGHT_THETA_EDGES_DEG", "Tallies",
     "Estimator",
     "SceneConfig",

@@ -17,7 +17,7 @@ import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
 from .base import ConfigError
-from .bottom import TableBottom
+from .bottom import ReflectanceSpectrum, TableBottom, reflectance_keys
 from .illumination import SkyMap
 from .phase import Mixture, TablePhase
 from .scene import SceneConfig
@@ -303,7 +303,8 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
 
 def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
     """(model, attribute, key path) of every data file the scene names: phase, component,
-    profile and spectrum tables, the bottom's BRDF table, the sky map."""
+    profile and spectrum tables, the bottom's BRDF table and reflectance spectra, the sky
+    map."""
     fields: list[tuple[object, str, str]] = []
     for i, layer in enumerate(config.water.layers):
         at = f"water.layers[{i}]"
@@ -322,6 +323,8 @@ def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
                    if isinstance(phase, TablePhase)]
     if isinstance(config.bottom, TableBottom):
         fields.append((config.bottom, "file", "bottom.file"))
+    fields += [(value, "file", f"{key}.file") for key, value in reflectance_keys(config.bottom)
+               if isinstance(value, ReflectanceSpectrum)]
     if config.illumination.spectrum.model == "table":
         fields.append((config.illumination.spectrum, "file", "illumination.spectrum.file"))
     if isinstance(config.illumination.sky, SkyMap):

@@ -7,7 +7,8 @@ from typing import Annotated
 from pydantic import Field, field_validator, model_validator
 
 from .base import _Strict
-from .bottom import Bottom, bottom_has_mirror, bottom_weight_bounded
+from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
+                     check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
 from .illumination import Illumination
 from .surface import MAX_CAP_MSS, Surface
@@ -77,8 +78,10 @@ class SceneConfig(_Strict):
             raise ValueError("bottom.model = 'none' needs an infinitely deep last layer "
                              "(thickness_m: .inf); a finite water column needs a bottom "
                              "(black, lambertian, minnaert, specular, lambertian_specular, "
-                             "ggx, hapke, table)")
-        self.water.check_wavelength_count(len(self.wavelengths), self.wavelengths_nm is not None)
+                             "ggx, hapke, table, mixture)")
+        spectral = self.wavelengths_nm is not None
+        self.water.check_wavelength_count(len(self.wavelengths), spectral)
+        check_bottom_wavelengths(self.bottom, len(self.wavelengths), spectral)
         depth = self.water.depth_m
         for d in self.tallies.depths_m:
             if d > depth * (1.0 + 1e-12):

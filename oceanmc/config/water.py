@@ -11,7 +11,7 @@ from pydantic import Field, field_validator, model_validator
 from .base import MAX_COEFFICIENT, MAX_THICKNESS_M, Coefficient, _Strict
 from .components import Component
 from .phase import Isotropic, Mixture, Phase
-from .wavelengths import BackscatterRatio, spectral
+from .wavelengths import BackscatterRatio, check_count, spectral
 
 
 def values(value: float | list[float]) -> list[float]:
@@ -101,14 +101,7 @@ class Water(_Strict):
                       for k, component in enumerate(layer.components or ())
                       for key, value in component if isinstance(value, list)]
             for key, value in lists:
-                if not isinstance(value, list):
-                    continue
-                if not spectral:
-                    raise ValueError(f"{key} is a list ({len(value)} values) but wavelengths_nm "
-                                     "is not given; give wavelengths_nm or one number")
-                if len(value) != n_wavelengths:
-                    raise ValueError(f"{key} has {len(value)} values; allowed: one number or one "
-                                     f"value per wavelength ({n_wavelengths} in wavelengths_nm)")
+                check_count(key, value, n_wavelengths, spectral)
 
     @property
     def depth_m(self) -> float:

@@ -66,21 +66,36 @@ def grid(value: Wavelengths | None) -> np.ndarray:
     return np.asarray(value, dtype=np.float64)
 
 
-# per-wavelength keys (water.layers[i].a, b, bb_ratio; components): one number or one per wavelength
+# per-wavelength keys (water.layers[i].a, b, bb_ratio; components; bottom.reflectance): one
+# number or one per wavelength
 # the Fournier-Forand phase functions are tabulated for these backscatter fractions
 MIN_BB_RATIO, MAX_BB_RATIO = 0.0005, 0.45
 BackscatterRatio = Annotated[float, Field(ge=MIN_BB_RATIO, le=MAX_BB_RATIO, allow_inf_nan=False)]
 
 
-def _one_or_list(value) -> str:
-    return "spectral_list" if isinstance(value, list) else "spectral_value"
+def spectral(number, table=None):
+    """One number, or a list of them (one per wavelength), or (where `table` is given, a model
+    naming a file) a spectrum read from a table; the discriminator makes a bad value report the
+    error of the form it was given in, not of all of them."""
+    def form(value) -> str:
+        if table is not None and isinstance(value, (dict, table)):
+            return "spectral_table"
+        return "spectral_list" if isinstance(value, list) else "spectral_value"
+    members = [Annotated[number, Tag("spectral_value")],
+               Annotated[Annotated[list[number], Field(min_length=1)], Tag("spectral_list")]]
+    if table is not None:
+        members.append(Annotated[table, Tag("spectral_table")])
+    return Annotated[Union[tuple(members)], Discriminator(form)]
 
 
-def spectral(number):
-    """One number, or a list of them (one per wavelength); the discriminator makes a bad value
-    report the error of the form it was given in, not of both."""
-    return Annotated[Union[Annotated[number, Tag("spectral_value")],
-                           Annotated[Annotated[list[number], Field(min_length=1)],
-                                     Tag("spectral_list")]],
-                     Discriminator(_one_or_list)]
-
+def check_count(key: str, value, n_wavelengths: int, spectral: bool) -> None:
+    """A spectral key given as a list has one value per wavelength, and lists need
+    `wavelengths_nm`; one line naming the key otherwise."""
+    if not isinstance(value, list):
+        return
+    if not spectral:
+        raise ValueError(f"{key} is a list ({len(value)} values) but wavelengths_nm is not "
+                         "given; give wavelengths_nm or one number")
+    if len(value) != n_wavelengths:
+        raise ValueError(f"{key} has {len(value)} values; allowed: one number or one value per "
+                         f"wavelength ({n_wavelengths} in wavelengths_nm)")

@@ -62,14 +62,14 @@ def build(config: cfg.SceneConfig) -> Scene:
     auxiliary files."""
     med, mf, mi, column = medium.pack(config)
     surf = surface.pack(config.surface, config.n_water)
-    bot, bp = bottom.pack(config.bottom)
+    bot, bp, bottom_shares = bottom.pack(config.bottom, config.wavelengths)
     sk, sf = sky.pack(optics.monochromatic_illumination(config))
     # the sky's share of the photons: the wavelengths' mean diffuse fraction (grid.source_q
     # gives each wavelength its own)
     sk[0]["diffuse_fraction"] = grid.stratified_fraction(optics.illumination_spectrum(config)[1])
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]), len(column.albedo))
+                                   len(directions[0]), len(column.albedo), bottom_shares)
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     no_ints = np.zeros(0, dtype=np.int64)
     (med, bot, sk, gr, est, surf), floats, ints = merge(
