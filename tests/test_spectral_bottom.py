@@ -6,6 +6,7 @@ kernel/spectral.py reflect and bottom_weights): the packing is checked here, and
 against single-wavelength runs of each wavelength's reflectance (z-scores, fixed seeds)."""
 import copy
 
+import h5py
 import numpy as np
 import pytest
 import yaml
@@ -254,6 +255,28 @@ def test_a_mixture_runs_as_the_lambertian_bottom_of_its_weighted_spectrum():
     for name in ("air/Rrs_nadir", "Eu", "Ed", "budget/absorbed_bottom"):
         np.testing.assert_allclose(runs[0][name], runs[1][name], rtol=1e-12, err_msg=name)
     assert np.all(runs[0]["budget/absorbed_bottom"] > 0.0)
+
+
+def test_results_record_the_reflectance_the_run_used(tmp_path):
+    """The results' iops group holds the bottom's reflectance per wavelength (a spectrum file
+    interpolated, a mixture weighted), in memory and in the file; bottoms without one have
+    none."""
+    path = spectrum_csv(tmp_path / "sand.csv", [(400, 0.1), (700, 0.4)])
+    mixture = {"model": "mixture", "components": [
+        {"fraction": 0.5, "model": "lambertian", "reflectance": SPECTRUM},
+        {"fraction": 0.5, "model": "lambertian", "reflectance": {"file": path}}]}
+    result = oceanmc.simulate(load_config(scene_dict(mixture)), threads=1)
+    sand = 0.1 + 0.3 * (np.array(WAVELENGTHS) - 400) / 300
+    expected = 0.5 * np.array(SPECTRUM) + 0.5 * sand
+    np.testing.assert_allclose(result.iops["bottom_reflectance"], expected, rtol=1e-14)
+    result.save(tmp_path / "out.h5")
+    loaded = oceanmc.load_result(tmp_path / "out.h5")
+    np.testing.assert_array_equal(loaded.iops["bottom_reflectance"],
+                                  result.iops["bottom_reflectance"])
+    with h5py.File(tmp_path / "out.h5") as f:
+        assert f["iops/bottom_reflectance"].dims[0][0].name == "/iops/wavelength"
+    black = oceanmc.simulate(load_config(scene_dict({"model": "black"})), threads=1)
+    assert "bottom_reflectance" not in black.iops
 
 
 # --- the physics: a spectral run against one run per wavelength ----------------------------------

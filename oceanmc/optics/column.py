@@ -231,11 +231,15 @@ def column_iops(config: cfg.SceneConfig) -> list[LayerIOPs]:
     return out
 
 
-def iops_table(layers: list[LayerIOPs], wl: np.ndarray) -> dict[str, np.ndarray]:
+def iops_table(layers: list[LayerIOPs], wl: np.ndarray,
+               bottom_reflectance: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The results file's `iops` group: a, b, bb, c (layer, wavelength), 1/m; layer_top,
-    layer_thickness (m), wavelength (nm)."""
+    layer_thickness (m), wavelength (nm); and bottom_reflectance (wavelength) where the bottom
+    has one."""
+    bottom = {} if bottom_reflectance is None else {
+        "bottom_reflectance": np.asarray(bottom_reflectance, dtype=np.float64)}
     return {"layer_top": np.array([layer.top_m for layer in layers]),
             "layer_thickness": np.array([layer.thickness_m for layer in layers]),
             "wavelength": np.asarray(wl, dtype=np.float64),
             **{name: np.stack([getattr(layer, name) for layer in layers])
-               for name in ("a", "b", "bb", "c")}}
+               for name in ("a", "b", "bb", "c")}, **bottom}

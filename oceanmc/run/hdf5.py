@@ -268,6 +268,12 @@ def _write_iops(group: h5py.Group, iops: dict[str, np.ndarray]) -> None:
         ds.attrs["units"], ds.attrs["description"] = "1/m", description
         ds.dims[0].attach_scale(group["layer_top"])
         ds.dims[1].attach_scale(group["wavelength"])
+    if "bottom_reflectance" in iops:
+        ds = group.create_dataset("bottom_reflectance", data=iops["bottom_reflectance"])
+        ds.attrs["units"] = "1"
+        ds.attrs["description"] = ("the bottom's reflectance at each wavelength as the run used "
+                                   "it (a mixture's fraction-weighted)")
+        ds.dims[0].attach_scale(group["wavelength"])
 
 
 class ResultsFileError(ValueError):

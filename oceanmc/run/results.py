@@ -55,7 +55,8 @@ class Result:
     # a partial run's unfinished batches, from which --resume continues them (simulation.py)
     resume_state: dict[str, np.ndarray] | None = None
     # the IOPs the run used (optics.iops_table): a, b, bb, c (layer, wavelength) in 1/m and the
-    # coordinates layer_top (m), layer_thickness (m), wavelength (nm); the file's group `iops`
+    # coordinates layer_top (m), layer_thickness (m), wavelength (nm), and the bottom's
+    # reflectance (wavelength) where it has one; the file's group `iops`
     iops: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:

@@ -280,7 +280,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         # before a checkpoint or the end hands it on to be written or returned
         check_finite(result, config.wavelengths)
         result.resume_state = state
-        result.iops = iops_table(sc.layers, config.wavelengths)
+        result.iops = iops_table(sc.layers, config.wavelengths, sc.bottom_reflectance)
         return result
 
     t1 = last_checkpoint = time.perf_counter()

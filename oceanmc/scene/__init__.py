@@ -32,6 +32,9 @@ class Scene:
     angles: Grid
     local_rows: list
     layers: tuple               # optics.LayerIOPs of each kernel layer
+    # (n_wl,) the bottom's reflectance at each wavelength (optics/bottom.py; a mixture's
+    # fraction-weighted), None for a bottom without one (black, ggx, hapke, table, ...)
+    bottom_reflectance: np.ndarray | None = None
 
     def kernel_args(self) -> tuple:
         return (self.medium, self.surface, self.bottom, self.sky, self.grid, self.estimates,
@@ -76,7 +79,8 @@ def build(config: cfg.SceneConfig) -> Scene:
         [(med, mf, mi), (bot, bp, no_ints), (sk, sf, no_ints), (gr, gf, gi), (est, ef, ei),
          (surf, surface.pool(config.surface, surf), no_ints)])
     return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column.albedo),
-                 floats, ints, angles, local_rows, column.layers)
+                 floats, ints, angles, local_rows, column.layers,
+                 optics.bottom_spectrum(config.bottom, config.wavelengths))
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]
