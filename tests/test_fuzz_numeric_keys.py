@@ -495,6 +495,19 @@ def test_spectral_layer_with_a_subnormal_b_at_one_wavelength_is_refused():
     assert "water.layers[0].b" in str(info.value) and "400 nm" in str(info.value)
 
 
+def test_spectral_layer_with_a_subnormal_b_at_every_wavelength_runs_finite():
+    """b = 1e-308 1/m at every wavelength (found by the spectral-bottom fuzz template) gave NaN:
+    such a layer is packed as not scattering (scene/medium.py B_FLOOR)."""
+    scene = _mono(wavelengths_nm=[400, 500, 600], tallies=SMALL_TALLIES, estimator={},
+                  water={"layers": [{"thickness_m": 2.0, "a": [0.1, 0.2, 0.1], "b": 1e-308}]},
+                  bottom={"model": "lambertian", "reflectance": 0.3})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        result = oceanmc.simulate(scene, threads=1)
+    assert not finite(result)
+    assert np.all(result["Eu"] > 0.0)
+
+
 def test_spectral_scene_with_no_upwelling_light_at_one_wavelength_runs():
     """Clear water (b = 0) over a bottom, absorbing 1000 1/m at one of two wavelengths: a
     KeyError traceback ('air/t_up'): from_tallies leaves the ratio Eu_water_leaving / Eu(0-)

@@ -94,6 +94,8 @@ def optical_depths(plane_z: np.ndarray, segment_layer: np.ndarray, c: np.ndarray
 
 # the spectral walk's smallest b at one wavelength relative to the layer's largest
 B_SPREAD_LIMIT = 1e-12
+# below this at every wavelength (1/m) a layer is packed as not scattering
+B_FLOOR = 1e-100
 
 
 def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
@@ -235,6 +237,10 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         cumweight[:, first:first + count] = np.cumsum(part, axis=1)
         cumweight[:, first + count - 1] = 1.0
     layer_b = np.array([layer.b for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
+    # a layer whose b stays below B_FLOOR at every wavelength scatters nothing in any water
+    # column (a mean free path of 1e100 m): packed as not scattering, since the spectral
+    # walk's ratios of beta (b 1e-308: subnormal) would overflow
+    layer_b[layer_b.max(axis=1) < B_FLOOR] = 0.0
     mix_ptr, mix_comp, mix_at, mix_coef = scattering_terms(
         share, comp_start, comp_count, layer_b, comp_model, comp_tables)
 
