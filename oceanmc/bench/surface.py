@@ -154,7 +154,7 @@ def report_lines(data: dict) -> list[str]:
               "| quantity | " + " | ".join(f"Rrs {name} (1/sr)" for name in fom_names) + " | "
               + " | ".join(f"FOM {name}" for name in fom_names) + " | "
               + " | ".join(f"{name} / flat" for name in fom_names[1:]) + " |",
-              "|---" * (3 * len(fom_names)) + "|---|"]
+              "|---" * (3 * len(fom_names)) + "|"]
     for label in data["fom"][flat]["quantities"]:
         q = [data["fom"][name]["quantities"][label] for name in fom_names]
         lines.append(f"| {label} | " + " | ".join(f"{x['value']:.5f}" for x in q) + " | "
