@@ -38,6 +38,11 @@ from .rng import uniform
 from .surface import dispatch as surface_bsdf
 
 
+# below this transmission (at mu = 1, the least attenuated wavelength) to the nearest level
+# above, a collision's cap scores play roulette (at_collision)
+CAP_ROULETTE = 0.05
+
+
 @internal
 def scratch(grid, work):
     """Views (n_wl each) of one event's weight at each wavelength, optical depth there, and
@@ -207,10 +212,26 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
         above = 0   # the tally levels at or above the collision (sorted by depth)
         while above < grid.n_depths and floats[grid.level_z + above] <= z:
             above += 1
+        # roulette on the cap's scores: when even the least attenuated wavelength keeps less
+        # than CAP_ROULETTE of its light on the way to the nearest level above (or to the
+        # surface), the collision scores with probability t / CAP_ROULETTE and its scores are
+        # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
+        # which send almost nothing up, cost a comparison instead of n_wl table reads
+        nearest = grid.level_tau + above - 1
+        least = math.inf
+        for j in range(n):
+            dtau = tau[j] - (floats[nearest + j * grid.n_depths] if above > 0 else 0.0)
+            least = min(least, dtau)
+        scale = 1.0
+        kept = math.exp(-least)
+        if kept < CAP_ROULETTE:
+            if uniform(rng) * CAP_ROULETTE >= kept:
+                return
+            scale = CAP_ROULETTE / kept
         for j in range(n):
             m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
-            cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j], m0w, m1w,
-                               m0a, m1a, j)
+            cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j] * scale, m0w,
+                               m1w, m0a, m1a, j)
 
 
 @internal
