@@ -6,7 +6,8 @@ facet, their first facets drawn by Latin hypercube sampling (cox_munk_table.walk
 weighted leaving directions a walk), in threads (the walks release the GIL); R is the reflected weight over the walks, and each branch's quantiles are the
 weighted empirical quantiles of its leaving directions (the value where the cumulative weight,
 counted to the middle of each sample, reaches the level; linear between samples, the extreme
-samples at levels 0 and 1). Each node has its own random stream and permutations from
+samples at levels 0 and 1); at normal incidence the azimuth is uniform by symmetry and its
+exact quantiles are stored. Each node has its own random stream and permutations from
 (TABLE_SEED, side, node), so a table is the same whatever the number of threads.
 
 Cache: CACHE_DIR's parent / surface_tables / cox_munk-<sources>-<key>.npy, <sources> a hash of
@@ -29,7 +30,7 @@ from ..kernel.rng import batch_state
 from ..kernel.surface import cox_munk_table as layout
 
 FORMAT_VERSION = 1
-WALKS_PER_NODE = 20_000
+WALKS_PER_NODE = 15_000
 TABLE_SEED = 20_161_126
 TABLE_DIR = CACHE_DIR.parent / "surface_tables"
 # the sources a table depends on: the walk, the table's layout and sampler, this builder
@@ -161,8 +162,15 @@ def _node(alpha: float, n_water: float, side: int, node: int) -> tuple[float, np
     branch, t, az, w = branch[:count], t[:count], az[:count], w[:count]
     reflected = branch == layout.REFLECTED
     r = float(w[reflected].sum() / WALKS_PER_NODE)
-    return (min(max(r, 0.0), 1.0), _quantiles(t[reflected], az[reflected], w[reflected]),
-            _quantiles(t[~reflected], az[~reflected], w[~reflected]))
+    blocks = (_quantiles(t[reflected], az[reflected], w[reflected]),
+              _quantiles(t[~reflected], az[~reflected], w[~reflected]))
+    if node == 0:
+        # normal incidence on isotropic slopes: the leaving azimuth is uniform on [0, pi] at
+        # every polar angle (symmetry), so its exact quantiles replace the sampled ones
+        for block in blocks:
+            block[layout.POLAR_EDGES:] = np.tile(np.tan(0.25 * np.pi * AZIMUTH_LEVELS),
+                                                 layout.POLAR_EDGES - 1)
+    return (min(max(r, 0.0), 1.0),) + blocks
 
 
 def build(alpha: float, n_water: float, threads: int | None = None) -> np.ndarray:
