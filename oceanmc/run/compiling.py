@@ -29,7 +29,7 @@ from numba.core.config import _OptLevel
 
 from ..kernel import records, transport
 from ..kernel.compile import CACHE_DIR
-from ..kernel.phase.dispatch import layer_density
+from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
 from ..kernel.transport import trace_batch
 
@@ -56,6 +56,7 @@ def _argument_types() -> dict[str, numba.types.Type]:
              "states": numba.typeof(np.zeros((1, 1))),
              "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
              "layer": numba.int64, "events": numba.int64, "wavelength": numba.int64,
+             "component": numba.int64,
              "n_photons": numba.int64, "start": numba.int64, "work_budget": numba.int64,
              "mu": numba.float64}
     for name, dtype in (("medium", records.MEDIUM), ("surface", records.SURFACE),
@@ -80,7 +81,7 @@ def parts() -> dict[str, list[tuple]]:
     return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
         ("bottom", (transport.reflect_at_bottom,)),
         ("water", (transport.collide, transport.enter_from_air, transport.leave_or_reflect)),
-        ("entry", (trace_batch, layer_density, transmittance)))}
+        ("entry", (trace_batch, component_density, transmittance)))}
 
 
 def compile_part(name: str) -> None:

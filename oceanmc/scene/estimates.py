@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import config as cfg
 from ..kernel.compile import CACHE_DIR
-from ..kernel.phase.dispatch import layer_density
+from ..kernel.phase.dispatch import component_density
 from ..kernel.records import ESTIMATES, Pool, record
 from ..kernel.surface.dispatch import transmittance
 from . import cap_tables
@@ -77,6 +77,23 @@ def _save(path: Path, table: np.ndarray) -> None:
         pass
 
 
+def component_table(m, mf: np.ndarray, mi: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(psi, q) of phase function component k's table in the pools (empty for an analytic
+    component; tables on one angle grid share its psi: kernel/phase/dispatch.py table_at)."""
+    start, length = mi[m["comp_tab_start"] + k], mi[m["comp_tab_len"] + k]
+    psi_start = m["tab_psi"] + mi[m["comp_psi_start"] + k]
+    return (mf[psi_start:psi_start + length],
+            mf[m["tab_q"] + start:m["tab_q"] + start + length])
+
+
+def component_key(m, mf: np.ndarray, mi: np.ndarray, k: int) -> bytes:
+    """A digest of phase function component k: its model, parameters and table."""
+    psi, q = component_table(m, mf, mi, k)
+    return hashlib.sha1(np.array([mi[m["comp_model"] + k], mf[m["comp_params"] + 2 * k],
+                                  mf[m["comp_params"] + 2 * k + 1]]).tobytes()
+                        + psi.tobytes() + q.tobytes()).digest()
+
+
 def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) -> bytes:
     """A digest of the layer's phase functions: its components' models, weights at every
     wavelength, parameters and tables."""
@@ -85,18 +102,35 @@ def layer_key(medium: np.ndarray, mf: np.ndarray, mi: np.ndarray, layer: int) ->
     n_comps = int(m["n_comps"])
     digest = hashlib.sha1()
     for k in range(first, first + count):
-        start, length = mi[m["comp_tab_start"] + k], mi[m["comp_tab_len"] + k]
         weights = mf[m["comp_cumweight"] + k:m["comp_cumweight"] + n_comps * int(m["n_wl"]):
                      n_comps]
-        digest.update(np.concatenate([[mi[m["comp_model"] + k]], weights,
-                                      [mf[m["comp_params"] + 2 * k],
-                                       mf[m["comp_params"] + 2 * k + 1]]]).tobytes())
-        digest.update(mf[m["tab_q"] + start:m["tab_q"] + start + length].tobytes())
-        digest.update(mf[m["tab_psi"] + start:m["tab_psi"] + start + length].tobytes())
+        digest.update(weights.tobytes() + component_key(m, mf, mi, k))
     return digest.digest()
 
 
-def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes) -> np.ndarray:
+_COMPONENT_MOMENTS: dict[bytes, np.ndarray] = {}
+
+
+def component_moments(m, mf, mi, k: int, caps, geometry_key: bytes) -> np.ndarray:
+    """(4, n_alpha): M0 and M1 of the water cap and of the air cap's water side for phase
+    function component k alone (caps(): the two caps' geometries), remembered within the
+    process by its content and the geometry."""
+    key = hashlib.sha1(geometry_key + component_key(m, mf, mi, k)).digest()
+    if key not in _COMPONENT_MOMENTS:
+        table = cap_tables.cumulative(lambda angles: component_density(m, mf, mi, k, angles),
+                                      component_table(m, mf, mi, k)[0])
+        water, air = caps()
+        _COMPONENT_MOMENTS[key] = np.array(
+            [*cap_tables.cap_moments(table, water),
+             *(cap_tables.rough_cap_moments(table, air) if isinstance(air, cap_tables.RoughCap)
+               else cap_tables.cap_moments(table, air))])
+        if len(_COMPONENT_MOMENTS) > 64:
+            _COMPONENT_MOMENTS.pop(next(iter(_COMPONENT_MOMENTS)))
+    return _COMPONENT_MOMENTS[key]
+
+
+def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
+                      geometry_key: bytes) -> np.ndarray:
     """(4, n_alpha, n_wl): M0 and M1 of the water cap and of the air cap's water side for the
     layer's phase function at each wavelength (caps(): the two caps' cap_tables.cap_geometry,
     built only if some table is), remembered by key (the phase functions' content and the
@@ -110,27 +144,16 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes) -> np.ndarra
     if key not in _CAP_CACHE:
         m = medium[0]
         first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
-        breaks = np.concatenate(
-            [mf[m["tab_psi"] + mi[m["comp_tab_start"] + k]:
-                m["tab_psi"] + mi[m["comp_tab_start"] + k] + mi[m["comp_tab_len"] + k]]
-             for k in range(first, first + count)] + [np.zeros(0)])
         n_wl, n_comps = int(m["n_wl"]), int(m["n_comps"])
-        water, air = caps()
-        out = np.empty((4, len(water[1]), n_wl))
-        done: dict[bytes, int] = {}   # wavelengths with the same phase function share moments
-        for j in range(n_wl):
-            at = m["comp_cumweight"] + j * n_comps + first
-            same = mf[at:at + count].tobytes()   # the same components' weights: the same p
-            if same in done:
-                out[:, :, j] = out[:, :, done[same]]
-                continue
-            done[same] = j
-            table = cap_tables.cumulative(lambda psi: layer_density(m, mf, mi, layer, j, psi),
-                                          breaks)
-            out[:, :, j] = [*cap_tables.cap_moments(table, water),
-                            *(cap_tables.rough_cap_moments(table, air)
-                              if isinstance(air, cap_tables.RoughCap)
-                              else cap_tables.cap_moments(table, air))]
+        # the moments are linear in the phase function: each wavelength's are its components'
+        # mixed with that wavelength's shares (a profile's sublayers and a spectrum's
+        # wavelengths share their components' tables)
+        parts = np.array([component_moments(m, mf, mi, k, caps, geometry_key)
+                          for k in range(first, first + count)])      # (count, 4, n_alpha)
+        cumulative = mf[m["comp_cumweight"]:m["comp_cumweight"] + n_wl * n_comps].reshape(
+            n_wl, n_comps)[:, first:first + count]
+        shares = np.diff(cumulative, axis=1, prepend=0.0)              # (n_wl, count)
+        out = np.einsum("wk,kma->maw", shares, parts)
         _CAP_CACHE[key] = out
         _save(path, out)
         if len(_CAP_CACHE) > 64:
@@ -181,16 +204,17 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
                 cap_tables.rough_cap_geometry(alphas, roughness, n, beta) if roughness
                 else cap_tables.cap_geometry(beta_w, mu_a, alphas))
 
+    geometry_key = _CAP_SOURCE + np.array(geometry).tobytes() + alphas.tobytes()
     tables: dict[bytes, int] = {}
     table_of_layer = []
     moments = []    # per table (4, n_alpha, n_wl): M0, M1 of the water cap, then the air cap
     for layer in range(len(column.albedo)):
-        key = hashlib.sha1(_CAP_SOURCE + np.array(geometry).tobytes() + alphas.tobytes()
-                           + layer_key(medium, mf, mi, layer)).digest() if enabled else b""
+        key = hashlib.sha1(geometry_key + layer_key(medium, mf, mi, layer)).digest() \
+            if enabled else b""
         if key not in tables:
             tables[key] = len(tables)
-            moments.append(layer_cap_moments(medium, mf, mi, layer, caps, key) if enabled
-                           else np.zeros((4, len(alphas), n_wl)))
+            moments.append(layer_cap_moments(medium, mf, mi, layer, caps, key, geometry_key)
+                           if enabled else np.zeros((4, len(alphas), n_wl)))
         table_of_layer.append(tables[key])
     cap_solid_angle = 4.0 * math.pi * math.sin(beta / 2.0) ** 2  # 2 pi (1 - cos beta), stably
     if roughness:

@@ -109,27 +109,19 @@ def evaluate(medium, floats, ints, layer, cos_psi):
 
 
 @setup
-def layer_density(medium, floats, ints, layer, wavelength, angles):
-    """q(psi) = 2 pi p(psi) sin(psi) of the layer's phase function at wavelength index
-    `wavelength`, at each angle (rad), for tables built once per scene; tabulated components
-    are read exactly, without the loss of precision of cos(psi) near 0."""
+def component_density(medium, floats, ints, component, angles):
+    """q(psi) = 2 pi p(psi) sin(psi) of one phase function component at each angle (rad), for
+    tables built once per scene (a layer's is the mixture of its components' with the shares of
+    each wavelength, comp_cumweight); tabulated components are read exactly, without the loss
+    of precision of cos(psi) near 0."""
     out = np.empty(angles.shape[0])
-    first = ints[medium.comp_start + layer]
-    cumweight = medium.comp_cumweight + wavelength * medium.n_comps
+    tabulated_model = ints[medium.comp_model + component] == PHASE_TABULATED
     for i in range(angles.shape[0]):
         angle = angles[i]
-        total = 0.0
-        previous = 0.0
-        for k in range(first, first + ints[medium.comp_count + layer]):
-            weight = floats[cumweight + k] - previous
-            previous = floats[cumweight + k]
-            if weight == 0.0:
-                continue
-            if ints[medium.comp_model + k] == PHASE_TABULATED:
-                psi_at, q_at, _, length = table_at(medium, ints, k)
-                total += weight * tabulated.density(floats, psi_at, q_at, length, angle)
-            else:
-                total += weight * 2.0 * math.pi * math.sin(angle) * evaluate_component(
-                    medium, floats, ints, k, math.cos(angle))
-        out[i] = total
+        if tabulated_model:
+            psi_at, q_at, _, length = table_at(medium, ints, component)
+            out[i] = tabulated.density(floats, psi_at, q_at, length, angle)
+        else:
+            out[i] = 2.0 * math.pi * math.sin(angle) * evaluate_component(
+                medium, floats, ints, component, math.cos(angle))
     return out
