@@ -110,15 +110,16 @@ def cap_lookup(est, floats, table, i, f, n_wl, j):
 
 
 @internal
-def from_air_through_rough(surface, ax, ay, az, rng):
+def from_air_through_rough(surface, floats, ax, ay, az, rng):
     """(ix, iy, iz, t): for the upward air direction o = (ax, ay, -az) (az > 0), an in-water
     direction of travel i whose light the rough surface sends into o, with t = 1, or t = 0
-    (nothing sent): one sample of the facet walk of a photon travelling -o from the air,
-    reversed. By the walk's reciprocity (f(i->o) / n_o^2 = f(o->i) / n_i^2 for a dielectric
-    BSDF; Veach 1997, PhD thesis, 5.2) the radiance L(o) at 0+ is the expectation of
+    (nothing sent): one sample of the rough surface (its table, or its facet walk) for a photon
+    travelling -o from the air, reversed. By the reciprocity of the walk and of its table
+    (f(i->o) / n_o^2 = f(o->i) / n_i^2 for a dielectric BSDF; Veach 1997, PhD thesis, 5.2;
+    tests/test_surface_table.py) the radiance L(o) at 0+ is the expectation of
     t L_water(i) / n^2."""
     ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, -ax, -ay, az, uniform(rng),
-                                                          rng)
+                                                          rng, floats)
     return -ox, -oy, -oz, weight if transmitted else 0.0
 
 
@@ -130,8 +131,8 @@ def into_water_through_rough(surface, est, floats, k, rng):
     n = surface.n_water
     ax = n * dx
     ay = n * dy
-    return from_air_through_rough(surface, ax, ay, math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay)),
-                                  rng)
+    return from_air_through_rough(surface, floats, ax, ay,
+                                  math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay)), rng)
 
 
 @internal
@@ -287,7 +288,7 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
             # the air cap's direction drawn uniformly, its light traced back through the
             # rough sea to one in-water direction (unbiased for the cap average)
             ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))
-            ix, iy, iz, t = from_air_through_rough(surface, ax, ay, mu_a, rng)
+            ix, iy, iz, t = from_air_through_rough(surface, floats, ax, ay, mu_a, rng)
             if t > 0.0 and iz < 0.0:
                 f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz) * t / (
                     n_water * n_water)
