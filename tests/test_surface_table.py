@@ -21,6 +21,7 @@ from oceanmc.kernel.surface import cox_munk_table as layout
 from oceanmc.kernel.surface import dispatch
 from oceanmc.scene import surface as surface_packer
 from oceanmc.scene import surface_table
+from surface_helpers import cell_transfer, projected
 
 N_WATER = 1.34
 WIND = 7.0
@@ -219,35 +220,6 @@ def test_the_tails_stay_where_the_walk_puts_them(seven, from_air, t_max, cut):
     nodes = t_max * (layout.NODES - 1)
     se = math.sqrt(tab + ref + n * ref / (surface_table.WALKS_PER_NODE * nodes))
     assert abs(tab - ref) / se < 4.0, (tab, ref, se)
-
-
-@numba.njit
-def cell_transfer(surface, floats, from_air, a, b, n, rng):
-    """Light arriving uniformly in projected solid angle from the cell a = (theta0, theta1,
-    phi0, phi1) of directions pointing away from the surface on the incident side: the
-    fraction of it the table sends into cell b, on the far side when b's angles are negative
-    (as tests/test_surface_cox_munk.py, through the table)."""
-    hits = 0
-    sign = 1.0 if from_air else -1.0
-    for _ in range(n):
-        c0, c1 = math.cos(a[0]) ** 2, math.cos(a[1]) ** 2
-        mu = math.sqrt(c0 + (c1 - c0) * uniform(rng))
-        phi = a[2] + (a[3] - a[2]) * uniform(rng)
-        s = math.sqrt(1.0 - mu * mu)
-        ox, oy, oz, w, t = dispatch.sample(surface, -s * math.cos(phi), -s * math.sin(phi),
-                                           sign * mu, uniform(rng), rng, floats)
-        if t != (b[0] < 0.0):
-            continue
-        theta = math.acos(min(1.0, abs(oz)))
-        phi_o = math.atan2(oy, ox) % (2.0 * math.pi)
-        if abs(b[0]) <= theta < abs(b[1]) and abs(b[2]) <= phi_o < abs(b[3]):
-            hits += 1
-    return hits
-
-
-def projected(cell):
-    t0, t1, p0, p1 = (abs(x) for x in cell)
-    return 0.5 * (math.sin(t1) ** 2 - math.sin(t0) ** 2) * (p1 - p0)
 
 
 @pytest.mark.parametrize("from_air", [True, False])
