@@ -129,6 +129,8 @@ def mm01(chl):
         np.interp(at, wl, table["e"])
 
 
+@pytest.mark.skipif(not MM01.is_file(), reason=f"{MM01} not beside the checkout: the table's "
+                    "licence keeps it out of the package (CI has shared/ beside its clone)")
 def test_kd_agrees_with_morel_and_maritorena_2001():
     """Deep water, sun at 30 deg (no sky), Kd = ln(Ed(0-) / Ed(z)) / z with z the first
     attenuation length 1/Kd_MM01 of each band (MM01's Kd is the upper layer's); 32 batches of
