@@ -6,8 +6,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +16,7 @@ from ..kernel.phase.dispatch import component_density
 from ..kernel.records import ESTIMATES, Pool, record
 from ..kernel.surface.dispatch import transmittance
 from . import cap_tables
+from .disk_cache import save_atomically
 from .grid import Grid
 from .medium import Column
 
@@ -62,19 +61,16 @@ _CAP_SOURCE = hashlib.sha1(Path(cap_tables.__file__).read_bytes()).digest()
 
 
 def _save(path: Path, table: np.ndarray) -> None:
-    """Keeps a table in the disk cache, atomically (a concurrent run never reads half a file),
-    and the newest _CAP_FILES_KEPT files only; nothing on a read-only install (the tables are
-    then computed in each process)."""
+    """Keeps a table in the disk cache (disk_cache.save_atomically), and the newest
+    _CAP_FILES_KEPT files only."""
+    if not save_atomically(path, table):
+        return
     try:
-        _CAP_DIR.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=_CAP_DIR, suffix=".npy", delete=False) as f:
-            np.save(f, table)
-        os.replace(f.name, path)
         kept = sorted(_CAP_DIR.glob("*.npy"), key=lambda p: p.stat().st_mtime)
         for old in kept[:-_CAP_FILES_KEPT]:
             old.unlink(missing_ok=True)
     except OSError:
-        pass
+        pass   # another run pruned the same file first
 
 
 def component_table(m, mf: np.ndarray, mi: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:

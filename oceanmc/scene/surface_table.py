@@ -28,6 +28,7 @@ import numpy as np
 from ..kernel.compile import CACHE_DIR
 from ..kernel.rng import batch_state
 from ..kernel.surface import cox_munk_table as layout
+from .disk_cache import save_atomically
 
 FORMAT_VERSION = 1
 WALKS_PER_NODE = 15_000
@@ -88,18 +89,14 @@ def table(alpha: float, n_water: float) -> np.ndarray:
     except (OSError, ValueError, EOFError):
         pass       # absent, unreadable or corrupt: built again below
     built = build(alpha, n_water)
-    try:
-        TABLE_DIR.mkdir(parents=True, exist_ok=True)
-        temporary = path.with_name(f"{path.stem}.{os.getpid()}.tmp")
-        with open(temporary, "wb") as out:
-            np.save(out, built)
-        os.replace(temporary, path)
+    if save_atomically(path, built):   # (a read-only location: used without being kept)
         prefix = path.name[:len("cox_munk-") + 12]
-        for old in TABLE_DIR.glob("cox_munk-*.npy"):
-            if not old.name.startswith(prefix):
-                old.unlink(missing_ok=True)
-    except OSError:
-        pass       # a read-only location: the table is used without being kept
+        try:
+            for old in TABLE_DIR.glob("cox_munk-*.npy"):
+                if not old.name.startswith(prefix):
+                    old.unlink(missing_ok=True)
+        except OSError:
+            pass   # another run removed it first
     return built
 
 
