@@ -66,9 +66,12 @@ SURFACE = {
 }
 
 # Collision channels: name -> (kernel model id, module in kernel/channels/). Elastic scattering
-# is every scene's; inelastic processes (water.inelastic) add theirs.
+# is every scene's; inelastic processes (water.inelastic, each a module in optics/inelastic/ of
+# the same name) add theirs, all run by channels/inelastic.py from their packed transfer.
 CHANNEL = {
     "elastic": (models.CHANNEL_ELASTIC, "elastic"),
+    "raman": (models.CHANNEL_RAMAN, "inelastic"),
+    "chlorophyll_fluorescence": (models.CHANNEL_CHLOROPHYLL_FLUORESCENCE, "inelastic"),
 }
 
 # Sky radiance shapes: schema name -> kernel model id; a map ({map: FILE}) is SKY_MAP or, with

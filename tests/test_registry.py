@@ -121,9 +121,10 @@ def test_surface_dispatch_reaches_each_model():
 
 
 def test_channel_registry_and_dispatch():
-    """Every registered collision channel has its module, its id is packed for every scene, and
-    the dispatch runs it: the elastic channel turns a packet and keeps its weight where the bias
-    is off."""
+    """Every registered collision channel has its module, its id is packed for the scenes that
+    use it, and the dispatch runs it: the elastic channel turns a packet and keeps its weight
+    where the bias is off; the inelastic channels take their share of every wavelength and
+    emit a packet of their own onto the stack, scored in their part of the tally row."""
     from numba import njit
 
     import oceanmc
@@ -136,12 +137,11 @@ def test_channel_registry_and_dispatch():
         importlib.import_module(f"oceanmc.kernel.channels.{module}")
 
     @njit(cache=False)
-    def run(arrays, channel, rng):
+    def run(arrays, rng):
         medium, mf, mi, ctrl, grid, packet, ps, work, tally = arrays
         p = packet[0]
         p.w, p.ux, p.uy, p.uz = 1.0, 0.0, 0.0, 1.0
-        channels.scatter(channel, medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0,
-                         rng)
+        channels.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, rng)
         return p.w, p.uz
 
     sc = scene.build(oceanmc.load_config({
@@ -152,5 +152,38 @@ def test_channel_registry_and_dispatch():
     arrays = (sc.medium, sc.floats, sc.ints, sc.estimator, sc.grid, np.zeros(1, dtype=records.PACKET),
               np.zeros(1), np.zeros(4), np.zeros(sc.tally_size))
     rng = batch_state(3, 0)
-    turned = [run(arrays, registry.CHANNEL["elastic"][0], rng) for _ in range(20)]
+    turned = [run(arrays, rng) for _ in range(20)]
     assert all(w == 1.0 for w, _ in turned) and len({uz for _, uz in turned}) == 20
+
+    @njit(cache=False)
+    def emit(sc_arrays, ps, stack, stack_ps, work, tally, rng):
+        medium, surface, ctrl, grid, est, floats, ints, packet = sc_arrays
+        p = packet[0]
+        p.w, p.ux, p.uy, p.uz, p.z, p.seg = 1.0, 0.0, 0.0, 1.0, 0.5, 0
+        return channels.emit(medium[0], surface[0], ctrl[0], grid[0], est[0], floats, ints,
+                             tally, work, stack, stack_ps, 0, p, ps, 0, rng)
+
+    inelastic = {"raman": {"b488_per_m": 0.05}, "chlorophyll_fluorescence": {}}
+    sc = scene.build(oceanmc.load_config({
+        "wavelengths_nm": {"start": 400, "stop": 700, "step": 10},
+        "water": {"layers": [{"thickness_m": 1.0, "components": [
+            {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": 5.0}]}],
+            "inelastic": inelastic},
+        "bottom": {"model": "black"}, "estimator": {"emission_weight": 1e-9}}))
+    ids = sc.ints[sc.medium[0]["channel_model"]:][:3]
+    assert list(ids) == [registry.CHANNEL[name][0] for name in
+                         ("elastic", "raman", "chlorophyll_fluorescence")]
+    n = int(sc.grid[0]["n_wl"])
+    packet = np.zeros(1, dtype=records.PACKET)
+    ps = np.zeros(records.packet_state_size(n))
+    ps[:n] = 1.0               # K
+    ps[n:2 * n] = 1.0 / n      # G
+    stack = np.zeros(4, dtype=records.PACKET)
+    stack_ps = np.zeros((4, records.packet_state_size(n)))
+    tally = np.zeros(sc.tally_size)
+    height = emit((sc.medium, sc.surface, sc.estimator, sc.grid, sc.estimates, sc.floats,
+                   sc.ints, packet), ps, stack, stack_ps, np.zeros(records.work_size(n)), tally,
+                  batch_state(3, 1))
+    assert height == 2 and list(stack["part"][:2]) == [1, 2]
+    size = int(sc.grid[0]["size"])
+    assert np.count_nonzero(tally[size:2 * size]) and np.count_nonzero(tally[2 * size:])

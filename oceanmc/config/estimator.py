@@ -11,6 +11,7 @@ from .base import _Strict
 # auto's upward fraction in spectral scenes: the Rrs nadir of a 31-band windy Case-1 scene to 1%
 # in 20-30 s where it took 1,000-10,000 s without it (benchmarks/real_scenes.md)
 AUTO_UPWARD_FRACTION = 0.1
+DEFAULT_EMISSION_WEIGHT = 0.05
 
 
 class Estimator(_Strict):
@@ -35,3 +36,9 @@ class Estimator(_Strict):
     # at least 0.01 deg: the kernel draws cos psi = 1 - u (1 - cos A), whose 1 - cos A is
     # accurate to 1e-8 relative there and loses all accuracy near 1e-6 deg
     upward_cone_deg: Annotated[float, Field(ge=0.01, le=90.0, allow_inf_nan=False)] = 15.0
+    # the least weight of a packet that an inelastic process (water.inelastic) emits; lighter
+    # emissions are made with probability weight / emission_weight and carry emission_weight
+    # (kernel/channels/inelastic.py). The default measured best for the Raman part of Rrs in
+    # clear water (benchmarks/inelastic.md)
+    emission_weight: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = \
+        DEFAULT_EMISSION_WEIGHT

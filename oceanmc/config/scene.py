@@ -4,19 +4,26 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from pydantic import Field, field_validator, model_validator
+import numpy as np
+
+from pydantic import Field, PrivateAttr, field_validator, model_validator
 
 from .base import _Strict
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
                      check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
 from .illumination import Illumination
+from .inelastic import transport_grid
 from .surface import MAX_CAP_MSS, Surface
 from .tallies import Tallies
 from .water import Water
 from .wavelengths import Wavelengths, check_increasing, grid
 
 MAX_PHOTONS = 10**13
+
+
+def _listed(wavelengths: list[float]) -> str:
+    return ", ".join(f"{w:g}" for w in wavelengths)
 
 
 class SceneConfig(_Strict):
@@ -31,6 +38,9 @@ class SceneConfig(_Strict):
     tallies: Tallies = Field(default_factory=Tallies)
     estimator: Estimator = Field(default_factory=Estimator)
     wavelengths_nm: Wavelengths | None = None
+    # the wavelengths the validator added to wavelengths_nm for the excitation of inelastic
+    # light (config/inelastic.py transport_grid); the run's summary names them
+    _added_wavelengths: list[float] = PrivateAttr(default_factory=list)
 
     @field_validator("wavelengths_nm")
     @classmethod
@@ -80,6 +90,7 @@ class SceneConfig(_Strict):
                              "(black, lambertian, minnaert, specular, lambertian_specular, "
                              "ggx, hapke, table, mixture)")
         spectral = self.wavelengths_nm is not None
+        self._extend_for_inelastic(spectral)
         self.water.check_wavelength_count(len(self.wavelengths), spectral)
         check_bottom_wavelengths(self.bottom, len(self.wavelengths), spectral)
         depth = self.water.depth_m
@@ -123,6 +134,38 @@ class SceneConfig(_Strict):
                              "exceed 1: analog bottom reflection (survival with probability = "
                              "weight) cannot carry it; use estimator.mode = 'implicit'")
         return self
+
+    def _extend_for_inelastic(self, spectral: bool) -> None:
+        """With inelastic light, wavelengths_nm becomes the traced grid (transport_grid),
+        or a one-line refusal naming the wavelengths needed where per-wavelength lists were
+        given for the requested grid only."""
+        inelastic = self.water.inelastic
+        if inelastic is None or not inelastic.processes():
+            return
+        names = ", ".join(f"water.inelastic.{name}" for name, _ in inelastic.processes())
+        if not spectral:
+            raise ValueError(f"{names} moves light between wavelengths: it needs "
+                             "wavelengths_nm (a list in nm, or {start, stop, step})")
+        requested = self.wavelengths
+        traced = transport_grid(requested, inelastic)
+        if len(traced) == len(requested):
+            return
+        added = [float(w) for w in traced if not np.isclose(requested, w).any()]
+        try:
+            self.water.check_wavelength_count(len(traced), True)
+            check_bottom_wavelengths(self.bottom, len(traced), True)
+        except ValueError as exc:
+            raise ValueError(
+                f"{names} needs the light of {_listed(added)} nm, which wavelengths_nm "
+                f"lacks; add them to wavelengths_nm and give the per-wavelength lists values "
+                f"there ({exc})") from None
+        self.wavelengths_nm = [float(w) for w in traced]
+        self._added_wavelengths = added
+
+    @property
+    def added_wavelengths(self) -> list[float]:
+        """The wavelengths (nm) added to the requested grid for inelastic light."""
+        return list(self._added_wavelengths)
 
     @property
     def nadir_local(self) -> bool:

@@ -10,6 +10,7 @@ from pydantic import Field, field_validator, model_validator
 
 from .base import MAX_COEFFICIENT, MAX_THICKNESS_M, Coefficient, _Strict
 from .components import Component
+from .inelastic import Inelastic
 from .phase import Isotropic, Mixture, Phase
 from .wavelengths import BackscatterRatio, check_count, spectral
 
@@ -71,6 +72,7 @@ class Layer(_Strict):
 
 class Water(_Strict):
     layers: list[Layer] = Field(min_length=1, max_length=100_000)
+    inelastic: Inelastic | None = None     # Raman scattering, fluorescence (config/inelastic.py)
 
     @model_validator(mode="after")
     def _infinite_last_only(self) -> "Water":

@@ -34,6 +34,7 @@ from .brdf import dispatch as brdf
 from .compile import internal, kernel
 from .geometry import from_angles
 from .phase import dispatch as phase
+from .phase import quadratic
 from .rng import uniform
 from .surface import dispatch as surface_bsdf
 
@@ -236,13 +237,23 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
 
 
 @internal
+def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz):
+    """What a point source sends per unit weight toward the travel direction (ox, oy, oz)
+    (world frame, upward): a bottom of BRDF `model` (model >= 0; the packet travelling (ux, uy,
+    uz), in the BRDF's local frame (x, -y, -z) as brdf.dispatch.reflect) its f in 1/sr; an
+    inelastic emission (model < 0) its phase function (1 + beta cos^2), beta at
+    floats[beta_at], about the packet's direction, over |oz| (a volume source: the radiance of
+    the light it sends grows as the path crosses a plane more obliquely, as a collision's)."""
+    if model >= 0:
+        return brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, -oz)
+    return quadratic.evaluate(floats[beta_at:], ux * ox + uy * oy + uz * oz) / -oz
+
+
+@internal
 def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng):
-    """Packet p meets the bottom travelling (ux, uy, uz) (in the BRDF's local frame (x, -y,
-    -z), as brdf.dispatch.reflect): the reflected radiance w f(wi, W) T in the exact
-    directions, and the polar-cap average from one direction W drawn uniformly in the cap (an
-    unbiased estimate of the cap average; f is bounded for every non-mirror BRDF), once in
-    water and once for the air cap, through the surface's transmittance; at every wavelength
-    (one BRDF shape, each wavelength's reflectance share in its weight)."""
+    """Packet p meets the bottom: the reflected radiance w f(wi, W) T in the exact directions
+    and the polar-cap averages (from_point), at every wavelength (one BRDF shape, each
+    wavelength's reflectance share in its weight)."""
     n = grid.n_wl
     weight, tau, _ = scratch(grid, work)
     bottom_plane = medium.n_planes - 1
@@ -252,9 +263,35 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
         spectral.bottom_weights(grid, floats, ps, p, weight)
     for j in range(n):
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
-    z = floats[medium.plane_z + bottom_plane]
-    ux, uy, uz = p.ux, p.uy, p.uz
-    model = bottom.model
+    from_point(est, grid, surface, floats, ints, bp, tally, weight, tau,
+               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, 0, rng)
+
+
+@internal
+def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, rng):
+    """An inelastic emission at packet p's collision (its weights at each wavelength in
+    work[2 n:3 n], channels/inelastic.py; its phase function's beta at floats[beta_at]): the
+    radiance it sends in the exact directions and the polar-cap averages (from_point), scored
+    in the emission's part of the tally row `tally`. The collisions of the emitted packet
+    score the rest of its light, as any packet's do."""
+    n = grid.n_wl
+    weight = work[2 * n:3 * n]
+    tau = work[3 * n:4 * n]
+    for j in range(n):
+        tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
+    from_point(est, grid, surface, floats, ints, floats, tally, weight, tau, p.z, p.ux, p.uy,
+               p.uz, -1, beta_at, rng)
+
+
+@internal
+def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, uy, uz, model,
+               beta_at, rng):
+    """The radiance a point source at depth z (optical depths tau, weights `weight` at each
+    wavelength; toward() says what it sends, a bottom's BRDF or an emission's phase function)
+    sends in the exact directions, and the polar-cap average from one direction W drawn
+    uniformly in the cap (an unbiased estimate of the cap average; what it sends is bounded),
+    once in water and once for the air cap, through the surface's transmittance."""
+    n = grid.n_wl
     if est.directions_on:
         rough = surface.delta == 0
         for k in range(est.n_dirs):
@@ -262,20 +299,20 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
             if rough and factor > 0.0:
                 ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
                 if t > 0.0 and iz < 0.0:
-                    f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz)
+                    f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
                     at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
                         tally[at + j] += (
                             weight[j] * f * t * math.exp(tau[j] / iz) * factor)
                 continue
             dx, dy, dz = direction(est, floats, k)
-            f = brdf.evaluate_local(model, bp, -ux, uy, uz, dx, -dy, -dz)
+            f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
             for j in range(n):
                 add_to_levels(est, floats, ints, grid, tally, z, tau[j], k, weight[j] * f, -dz, j)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
-        f = brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, oz)
+        f = toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, -oz)
         for j in range(n):
             taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
@@ -290,7 +327,7 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
             ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))
             ix, iy, iz, t = from_air_through_rough(surface, floats, ax, ay, mu_a, rng)
             if t > 0.0 and iz < 0.0:
-                f = brdf.evaluate_local(model, bp, -ux, uy, uz, ix, -iy, -iz) * t / (
+                f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz) * t / (
                     n_water * n_water)
                 for j in range(n):
                     tally[grid.cap + grid.n_depths * n + j] += (
@@ -300,8 +337,8 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
         t = surface_bsdf.transmittance(surface, mu_w)
         phi = 2.0 * math.pi * uniform(rng)
-        f = brdf.evaluate_local(model, bp, -ux, uy, uz, sin_w * math.cos(phi),
-                                -sin_w * math.sin(phi), mu_w)
+        f = toward(model, bp, floats, beta_at, ux, uy, uz, sin_w * math.cos(phi),
+                   sin_w * math.sin(phi), -mu_w)
         for j in range(n):
             tally[grid.cap + grid.n_depths * n + j] += (
                 weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

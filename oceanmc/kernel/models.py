@@ -42,6 +42,8 @@ SKY_MAP_COSINE = 4       # a map sampled cosine-weighted, each photon weighted b
 
 # Collision channels (kernel/channels/).
 CHANNEL_ELASTIC = 0
+CHANNEL_RAMAN = 1                     # Raman scattering by water (channels/inelastic.py)
+CHANNEL_CHLOROPHYLL_FLUORESCENCE = 2  # fluorescence of phytoplankton (channels/inelastic.py)
 
 # Budget terms (columns of the budget tally); absorbed-per-layer columns follow BUDGET_LAYERS.
 BUDGET_SURFACE_REFLECTION = 0

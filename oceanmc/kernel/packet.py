@@ -29,9 +29,9 @@ def free_path_at(grid):
 
 @internal
 def launch(p, w, ux, uy, uz, beam):
-    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz);
-    beam: it belongs to the collimated solar beam (the spectral state is set by
-    spectral.start)."""
+    """The packet at the surface (z = 0, segment 0) with weight w and direction (ux, uy, uz),
+    of the elastic light; beam: it belongs to the collimated solar beam (the spectral state is
+    set by spectral.start)."""
     p.z = 0.0
     p.seg = 0
     p.w = w
@@ -39,6 +39,7 @@ def launch(p, w, ux, uy, uz, beam):
     p.uy = uy
     p.uz = uz
     p.beam = 1 if beam else 0
+    p.part = 0
 
 
 @internal
@@ -53,6 +54,7 @@ def copy(grid, dst, dst_ps, src, src_ps):
     dst.beam = src.beam
     dst.wavelength = src.wavelength
     dst.reference = src.reference
+    dst.part = src.part
     if grid.n_wl > 1:
         for j in range(free_path_at(grid) + 1):
             dst_ps[j] = src_ps[j]

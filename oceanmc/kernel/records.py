@@ -55,22 +55,26 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               up_fraction, up_density, up_keep (n_layers); comp_cumweight (n_wl x n_comps;
 #               cumulative within each layer), comp_params (2 each); tab_psi (each distinct
 #               angle grid once, at a component's psi_start), tab_q, tab_cdf (each table at
-#               its component's tab_start); mix_coef; channel_b (n_layers x n_channels x n_wl: each collision
-#               channel's scattering coefficient, adding up to the layer's b; kernel/channels/)
+#               its component's tab_start); mix_coef; the inelastic channels 1 ..
+#               n_channels - 1 (kernel/channels/inelastic.py): channel_beta (n_channels: the
+#               emission's phase function (1 + beta cos^2), 0 isotropic), channel_sigma
+#               ((n_channels - 1) x n_layers x n_wl: what each takes per unit weight and
+#               length), channel_reach ((n_channels - 1) x n_wl: the row sums of its
+#               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, excitation-major)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
 #               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1),
 #               mix_comp, mix_at: the terms of each layer's volume scattering functions, all
 #               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py);
-#               channel_model (n_channels: registry.CHANNEL ids)
+#               channel_model (n_channels: registry.CHANNEL ids; channel 0 is elastic)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),
     floats_at=("plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
                "layer_c_over_b", "layer_settle_path", "up_fraction", "up_density", "up_keep",
                "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-               "channel_b"),
+               "channel_beta", "channel_sigma", "channel_reach", "channel_transfer"),
     ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
              "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
              "mix_comp", "mix_at", "channel_model"))
@@ -110,12 +114,14 @@ SKY = _record(
 #               score with its n_wl wavelengths side by side: the offsets below are those of
 #               one wavelength's layout, and the score at offset i of wavelength j lies at
 #               scores + (i - scores) n_wl + j (tally.py spectral_at: the same address when
-#               n_wl = 1)
+#               n_wl = 1). That is one part, `size` long; the row holds n_parts of them, one
+#               per collision channel: the elastic light's, then each inelastic process's
+#               (the light it emitted; kernel/channels/inelastic.py)
 GRID = _record(
-    "n_wl", "scores", "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on",
+    "n_wl", "n_parts", "scores", "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on",
     "n_theta", "n_phi", "n_lookup", "theta_cols", "phi_cols",
     "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
-    ints=("n_wl", "scores", "n_depths", "air_level", "surface_level", "radiance_on", "n_theta",
+    ints=("n_wl", "n_parts", "scores", "n_depths", "air_level", "surface_level", "radiance_on", "n_theta",
           "n_phi", "n_lookup", "theta_cols", "phi_cols", "flux", "radiance", "local", "cap",
           "budget", "n_dirs", "n_budget", "size"),
     floats_at=("source_q", "bottom_q", "theta_mu_edges", "phi_edge_cos", "phi_edge_sin",
@@ -137,17 +143,21 @@ ESTIMATES = _record(
     ints_at=("in_water", "table_of_layer"))
 
 # How weights evolve (kernel/transport.py).
+# emission_weight: the least weight of a packet an inelastic process emits (lighter emissions
+# play roulette up to it: kernel/channels/inelastic.py)
 ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",
-                    "split_weight", "splitting", "upward",
+                    "split_weight", "splitting", "upward", "emission_weight",
                     ints=("analog", "max_events", "splitting", "upward"))
 
 # A photon packet: position (depth z and the segment it is in or on), weight, direction of
-# travel, whether it still belongs to the collimated solar beam, and its wavelength's index (in
-# a spectral walk, the hero's, and the reference wavelength's: kernel/spectral.py scatter).
-PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength", "reference",
-                 ints=("seg", "beam", "wavelength", "reference"))
+# travel, whether it still belongs to the collimated solar beam, its wavelength's index (in
+# a spectral walk, the hero's, and the reference wavelength's: kernel/spectral.py scatter),
+# and the part of the tally row it scores in (0: elastic light; k: light that channel k
+# emitted, kernel/channels/inelastic.py).
+PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength", "reference", "part",
+                 ints=("seg", "beam", "wavelength", "reference", "part"))
 
-# Rows on the split stack of one batch (kernel/transport.py)
+# Rows on the stack of one batch: split copies and emitted packets (kernel/transport.py)
 SPLIT_STACK_ROWS = 64
 
 
@@ -161,7 +171,9 @@ def packet_state_size(n_wl: int) -> int:
 def work_size(n_wl: int) -> int:
     """Floats of one event's scratch: a collision's volume scattering function at every
     wavelength (kernel/spectral.py), then a local estimate's weight, optical depth and phase
-    function at every wavelength (kernel/local_estimate.py)."""
+    function at every wavelength (kernel/local_estimate.py). An inelastic emission's weights
+    per unit coefficient, what it takes and what it emits use the first three of these rows
+    (kernel/channels/inelastic.py)."""
     return 4 * n_wl
 
 

@@ -17,10 +17,12 @@ STATE_WORDS = 4
 _TO_UNIT = 1.0 / 9007199254740992.0   # 2^-53
 
 
-def batch_state(seed: int, batch: int) -> np.ndarray:
+def batch_state(seed: int, batch: int, stream: int = 0) -> np.ndarray:
     """The generator state of batch `batch` of a run with seed `seed` (never all zero: the
-    generator's one forbidden state, probability 2^-256)."""
-    state = np.random.SeedSequence(int(seed), spawn_key=(int(batch),)).generate_state(
+    generator's one forbidden state, probability 2^-256); stream 1 is the batch's second
+    stream, which inelastic emissions draw from (kernel/channels/inelastic.py)."""
+    key = (int(batch),) if stream == 0 else (int(batch), int(stream))
+    state = np.random.SeedSequence(int(seed), spawn_key=key).generate_state(
         STATE_WORDS, np.uint64)
     if not state.any():
         state[0] = 1

@@ -217,19 +217,19 @@ def phase_values(medium, floats, ints, layer, cos_psi, out):
 
 
 @kernel
-def collision_weights(medium, floats, grid, ps, p, layer, weight):
-    """What a collision of the packet sends at each wavelength, as a local estimate needs it,
-    without settling: with e_j = exp(-(c_j - c_h) D) the deferred factors, a settle would make
-    F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w took of the
-    reference's), and adding the collision point to the path gives wavelength j the factor b_j
-    (its scattering) and each K_k the factor c_k (its collision density), so weight_j = p.w s
-    G_j e_j b_j / mean_k(K_k e_k c_k) (the mean of K e cancels; one wavelength: w b / c, the
-    implicit-capture weight)."""
+def collision_density(medium, floats, grid, ps, p, layer, weight):
+    """What a collision of the packet carries per unit coefficient at each wavelength, without
+    settling: times a wavelength's scattering coefficient b_j it is what the collision
+    scatters (collision_weights), times an inelastic process's coefficient what that process
+    takes (channels/inelastic.py). With e_j = exp(-(c_j - c_h) D) the deferred factors, a
+    settle would make F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w
+    took of the reference's), and adding the collision point to the path gives each K_k the
+    factor c_k (its collision density), so weight_j = p.w s G_j e_j / mean_k(K_k e_k c_k) (the
+    mean of K e cancels; one wavelength: w / c, the implicit-capture weight per unit b)."""
     n = grid.n_wl
     k, g, _ = weights(grid, ps)
     row = medium.layer_c + layer * n
     c = floats[row:row + n]
-    albedo = floats[medium.layer_albedo + layer * n:medium.layer_albedo + layer * n + n]
     dist = ps[free_path_at(grid)]
     c_h = c[p.wavelength]
     for j in range(n):
@@ -239,7 +239,20 @@ def collision_weights(medium, floats, grid, ps, p, layer, weight):
         total += k[j] * weight[j] * c[j]
     scale = p.w * math.exp((c[p.reference] - c_h) * dist) * n / total
     for j in range(n):
-        weight[j] *= scale * g[j] * albedo[j] * c[j]
+        weight[j] *= scale * g[j]
+
+
+@kernel
+def collision_weights(medium, floats, grid, ps, p, layer, weight):
+    """What a collision sends at each wavelength, as a local estimate needs it, without
+    settling: collision_density times b_j (the albedo times c)."""
+    n = grid.n_wl
+    collision_density(medium, floats, grid, ps, p, layer, weight)
+    row = layer * n
+    albedo = floats[medium.layer_albedo + row:medium.layer_albedo + row + n]
+    c = floats[medium.layer_c + row:medium.layer_c + row + n]
+    for j in range(n):
+        weight[j] *= albedo[j] * c[j]
 
 
 @kernel

@@ -157,7 +157,8 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
         target = -1
         dist = math.inf
     budget = grid.budget
-    if albedo > 0.0:
+    # with inelastic processes every layer has collisions (Raman scattering is the water's own)
+    if albedo > 0.0 or medium.n_channels > 1:
         s = tau * floats[medium.layer_inv_c + at]
         if s < dist:
             p.z += s * uz
@@ -194,15 +195,20 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
 
 
 @internal
-def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, p, layer, events,
-            rng):
-    """A collision in `layer`: local estimates, absorption (implicit: weight times the albedo),
-    one of the scene's collision channels (kernel/channels/) by its share of the scattering,
-    roulette. Returns (alive, optical depth to the next collision)."""
+def collide(medium, surface, ctrl, grid, est, floats, ints, tally, tally_row, ps, work, stack,
+            stack_ps, n_stacked, p, layer, events, rng, rng_emitted):
+    """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
+    channels/: they take their share of every wavelength and push packets of their own on the
+    stack), absorption (implicit: weight times the albedo), elastic scattering, roulette.
+    tally: the packet's part of the tally row tally_row. Returns (alive, optical depth to the
+    next collision, stack height)."""
     albedo = floats[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
-    if est.directions_on or est.cap_on:   # (a spectral walk settles there: p.w may change)
+    if (est.directions_on or est.cap_on) and albedo > 0.0:
+        # (a spectral walk settles there: p.w may change)
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
+    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work,
+                              stack, stack_ps, n_stacked, p, ps, layer, rng_emitted)
     w = p.w
     budget = grid.budget
     if ctrl.analog:
@@ -211,27 +217,29 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, p, 
                 spectral.lose(grid, tally, ps, layer)
             else:
                 score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w)
-            return False, 0.0
+            return False, 0.0, n_stacked
     else:
+        if albedo <= 0.0:   # a layer that only scatters inelastically (channels.emit)
+            spectral.lose(grid, tally, ps, layer)
+            return False, 0.0, n_stacked
         scattered = w * albedo
         if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
             score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w - scattered)
         p.w = scattered
-    channel = channels.choose(medium, floats, layer, p.wavelength, rng)
-    channels.scatter(channel, medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
+    channels.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
     p.beam = 0
     tau = exponential(rng)
     if grid.n_wl > 1:
         if not spectral.survives_roulette(medium, floats, ctrl, grid, tally, ps, p, layer, rng):
-            return False, tau
+            return False, tau, n_stacked
     elif not survives_roulette(ctrl, p, rng):
-        return False, tau
+        return False, tau, n_stacked
     if events >= ctrl.max_events:
         if grid.n_wl > 1:
             spectral.settle(medium, floats, grid, tally, ps, p, layer)
         score(grid, tally, ps, budget + BUDGET_TRUNCATED, p.w)
-        return False, tau
-    return True, tau
+        return False, tau, n_stacked
+    return True, tau, n_stacked
 
 
 @internal
@@ -335,15 +343,16 @@ def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_p
 
 @batch
 def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
-                floats, ints, n_photons, start, work_budget, rng, beam_in, tally, packet_row,
-                stack, states, work):
+                floats, ints, n_photons, start, work_budget, rng, rng_emitted, beam_in,
+                tally_row, packet_row, stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
 
     A batch may thus be traced in any number of calls, each continuing where the last stopped,
     with the same draws and the same additions in the same order as one call: its state between
-    calls is its random stream rng (kernel/rng.py, advanced in place), the next photon index
+    calls is its random streams rng and rng_emitted (kernel/rng.py, advanced in place; the
+    second draws what inelastic emissions do: channels/inelastic.py), the next photon index
     (-1 at the start), its tally row, and beam_in, the entered solar beam (weight per sun
     packet and direction below the surface) that packet -1 computes once per batch in implicit
     mode; the split stack is empty between photons. The packet is packet_row[0] with the spectral
@@ -392,6 +401,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         packet.launch(p, w, ux, uy, uz, not from_sky)
+        tally = tally_row[:grid.size]
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
@@ -405,31 +415,34 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
             spectral.carry(grid, ps, p)
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
+        draws = rng
         while True:
             # the walk of packet p as a sequence of events, until it leaves, is absorbed or
-            # loses roulette; then the next of its split copies, if any
-            tau = exponential(rng)
+            # loses roulette; then the next of its split copies or emitted packets, if any
+            tau = exponential(draws)
             alive = True
             walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
                 outcome, where, tau = free_flight(medium, ctrl, grid, floats, ints, tally, ps, p,
-                                                  tau, rng)
+                                                  tau, draws)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
-                    alive, tau = collide(medium, surface, ctrl, grid, est, floats, ints, tally,
-                                         ps, work, p, where, walk_events, rng)
+                    alive, tau, n_stacked = collide(medium, surface, ctrl, grid, est, floats,
+                                                    ints, tally, tally_row, ps, work, stack,
+                                                    stack_ps, n_stacked, p, where, walk_events,
+                                                    draws, rng_emitted)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
                         alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
-                                                 rng)
+                                                 draws)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
-                                                  floats, ints, bp, tally, ps, work, p, rng)
+                                                  floats, ints, bp, tally, ps, work, p, draws)
                     if alive and plane != PLANE_INSIDE:
                         alive, n_stacked = after_reflection(medium, ctrl, grid, floats, ints,
                                                             tally, ps, stack, stack_ps,
-                                                            n_stacked, p, level, rng)
+                                                            n_stacked, p, level, draws)
                 else:
                     alive = False
             events += walk_events
@@ -437,4 +450,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                 break
             n_stacked -= 1
             packet.copy(grid, p, ps, stack[n_stacked], stack_ps[n_stacked])
+            # an emitted packet scores in its process's part and draws from the second stream
+            tally = tally_row[p.part * grid.size:(p.part + 1) * grid.size]
+            draws = rng if p.part == 0 else rng_emitted
     return n_photons, events

@@ -15,14 +15,14 @@ against a finer layering."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .. import config as cfg
 from ..config import ConfigError
 from ..config.components import PROFILE_KEYS
-from . import profiles
+from . import inelastic, profiles
 from .components import Contribution, fournier_forand_by_ratio, iops, per_wavelength
 from .phases import backscatter_fraction
 
@@ -49,6 +49,7 @@ class LayerIOPs:
     weights: np.ndarray         # (n_wl, n_phases): share of b scattered by each phase; rows sum
     #                             to 1 (a wavelength that does not scatter: any valid row)
     config_layer: int           # index in config.water.layers
+    a_phytoplankton: np.ndarray | None = None   # (n_wl,) the part of a that may fluoresce
 
     @property
     def c(self) -> np.ndarray:
@@ -81,13 +82,15 @@ def mix(parts: list[Contribution]) -> Contribution:
     weights = np.stack(columns, axis=1)
     empty = b <= 0.0
     weights[empty] = np.stack(fallback, axis=1)[empty]
-    return Contribution(a, b, tuple(phases), weights)
+    living = [p.a_phytoplankton for p in parts if p.a_phytoplankton is not None]
+    return Contribution(a, b, tuple(phases), weights,
+                        np.sum(living, axis=0) if living else None)
 
 
 def _layer(part: Contribution, top: float, thickness: float, index: int) -> LayerIOPs:
     fractions = np.array([backscatter_fraction(p) for p in part.phases])
     return LayerIOPs(top, thickness, part.a, part.b, part.b * (part.weights @ fractions),
-                     part.phases, part.weights, index)
+                     part.phases, part.weights, index, part.a_phytoplankton)
 
 
 def _given(layer: cfg.Layer, n_wl: int) -> Contribution:
@@ -212,7 +215,8 @@ def _constituent_layers(layer: cfg.Layer, top: float, wl: np.ndarray, index: int
 
 
 def column_iops(config: cfg.SceneConfig) -> list[LayerIOPs]:
-    """The layers top to bottom, each homogeneous; the last may be infinitely deep."""
+    """The layers top to bottom, each homogeneous; the last may be infinitely deep. Raman
+    scattering's loss (optics/inelastic/raman.py) is in every layer's absorption."""
     wl = config.wavelengths
     out: list[LayerIOPs] = []
     top = 0.0
@@ -222,6 +226,9 @@ def column_iops(config: cfg.SceneConfig) -> list[LayerIOPs]:
         else:
             out += _constituent_layers(layer, top, wl, index)
         top += layer.thickness_m
+    extra = inelastic.extra_attenuation(config)
+    if extra is not None:
+        out = [replace(layer, a=layer.a + extra) for layer in out]
     last = out[-1]
     if math.isinf(last.thickness_m):
         stuck = (last.b > 0.0) & (last.a <= 0.0)

@@ -52,10 +52,13 @@ def _argument_types() -> dict[str, numba.types.Type]:
     `floats` and `ints`, the packet p and its spectral state ps, ...)."""
     f8 = numba.typeof(np.zeros(1))
     types = {"floats": f8, "ints": numba.typeof(np.zeros(1, dtype=np.int64)),
-             "bp": f8, "tally": f8, "ps": f8, "work": f8, "beam_in": f8, "angles": f8,
-             "states": numba.typeof(np.zeros((1, 1))),
+             "bp": f8, "tally": f8, "tally_row": f8, "ps": f8, "work": f8, "beam_in": f8,
+             "angles": f8, "states": numba.typeof(np.zeros((1, 1))),
+             "stack_ps": numba.typeof(np.zeros((1, 1))),
              "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "rng_emitted": numba.typeof(np.zeros(1, dtype=np.uint64)),
              "layer": numba.int64, "events": numba.int64, "wavelength": numba.int64,
+             "n_stacked": numba.int64,
              "component": numba.int64,
              "n_photons": numba.int64, "start": numba.int64, "work_budget": numba.int64,
              "mu": numba.float64}

@@ -251,7 +251,9 @@ RAD_UNITS = "W m-2 sr-1 (per unit Ed0)"
 IRR_UNITS = "W m-2 (per unit Ed0)"
 
 
-def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
+def budget_terms(n_layers: int, inelastic: bool = False) -> list[tuple[int, str, str]]:
+    """(column, name, description) of the budget's terms; with inelastic light, also what
+    the processes take from each wavelength and give to it (kernel/channels/)."""
     terms = [
         (models.BUDGET_SURFACE_REFLECTION, "surface_reflection",
          "fraction of Ed(0+) reflected by the surface (sun glint and sky reflection)"),
@@ -266,6 +268,14 @@ def budget_terms(n_layers: int) -> list[tuple[int, str, str]]:
         (models.BUDGET_TRUNCATED, "truncated",
          "fraction of Ed(0+) still alive when photons reached estimator.max_events (should be 0)"),
     ]
+    if inelastic:
+        terms += [
+            (models.BUDGET_SHIFTED_OUT, "shifted_out",
+             "fraction of Ed(0+) that inelastic processes took from this wavelength (energy)"),
+            (models.BUDGET_SHIFTED_IN, "shifted_in",
+             "energy that inelastic processes gave to this wavelength, as a fraction of its "
+             "Ed(0+); counted negative in budget/total"),
+        ]
     return terms
 
 
@@ -278,12 +288,13 @@ def sun_of(config) -> tuple[float, float]:
 def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_batch: int,
                  ed0: float, n_layers: int, radiance: bool, attrs: dict,
                  directions: list = (), local_rows: list = (), nadir_local: bool = False,
-                 sun: tuple[float, float] | None = None) -> Result:
+                 sun: tuple[float, float] | None = None, inelastic: bool = False) -> Result:
     """Normalises raw per-batch weight sums (per launched photon, times Ed0; radiances also per
     quad solid angle) and derives the contract's quantities. directions: the (theta, phi) of the
     local estimates, local_rows: their (water row, air row) in raw["local"]; nadir_local: Lu,
     Lw_nadir and Rrs_nadir come from the local polar-cap estimate in raw["cap"]; sun: (its
-    zenith angle in deg, direct Ed(0+)), for the sky radiance in rho (no rho without it)."""
+    zenith angle in deg, direct Ed(0+)), for the sky radiance in rho (no rho without it);
+    inelastic: the budget has the inelastic processes' terms."""
     scale = ed0 / n_per_batch
     omega = grid.solid_angle
     q: dict[str, Quantity] = {}
@@ -408,13 +419,17 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
                 "sea-surface reflectance factor L_reflected_local / L_sky, L_sky the sky "
                 "radiance (sun excluded) in the direction a flat surface reflects into the view")
     budget = raw["budget"] / n_per_batch
-    terms = budget_terms(n_layers)
+    terms = budget_terms(n_layers, inelastic)
     for column, name, description in terms:
         add(f"budget/{name}", (), budget[:, column], "1", description)
     # the kernel's columns for inelastic transfers (kernel/channels/) stay 0 without an
-    # inelastic process, and are left out
-    add("budget/total", (), budget[:, sorted(column for column, _, _ in terms)].sum(axis=1),
-        "1", "sum of all budget terms: 1 up to Russian-roulette noise")
+    # inelastic process, and are left out; what a process gives counts negative
+    columns = sorted(column for column, _, _ in terms)
+    signed = budget[:, columns] * np.where(np.array(columns) == models.BUDGET_SHIFTED_IN,
+                                           -1.0, 1.0)
+    add("budget/total", (), signed.sum(axis=1),
+        "1", "sum of all budget terms: 1 up to Russian-roulette noise (an inelastic "
+        "process's part: 0)")
     coords = {
         "depth": np.asarray(depths, dtype=np.float64),
         "theta": grid.theta, "phi": grid.phi,
@@ -426,6 +441,32 @@ def from_tallies(raw: dict[str, np.ndarray], grid, depths: np.ndarray, n_per_bat
     attrs = dict(attrs)
     attrs["Lu_method"] = lu_method
     return Result(coords, q, attrs)
+
+
+# what is not split into the parts of the light (add_parts): ratios, not sums over photons
+NOT_SPLIT = frozenset({"air/t_up", "air/rho", "air/rho_local"})
+
+
+def add_parts(whole: Result, parts: dict[str, Result]) -> None:
+    """Adds to `whole` every quantity of each part of the light (elastic, raman,
+    chlorophyll_fluorescence: the parts of the tally row, kernel/channels/) under the part's
+    name: raman/air/Rrs_nadir is the Raman light's Rrs, and the parts of a quantity add up to
+    it batch by batch, so each part has its own standard error. Ratios are not split
+    (NOT_SPLIT)."""
+    for part_name, part in parts.items():
+        for name, q in part.quantities.items():
+            if name in NOT_SPLIT:
+                continue
+            whole.quantities[f"{part_name}/{name}"] = Quantity(
+                f"{part_name}/{name}", q.dims, q.batches, q.units,
+                f"{q.description} ({PART_DESCRIPTIONS[part_name]})")
+
+
+PART_DESCRIPTIONS = {
+    "elastic": "the light no inelastic process has emitted",
+    "raman": "the light Raman scattering by water emitted",
+    "chlorophyll_fluorescence": "the light phytoplankton fluoresced",
+}
 
 
 def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:

@@ -27,16 +27,18 @@ from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.models import BUDGET_LAYERS
-from ..kernel.records import PACKET, SPLIT_STACK_ROWS, packet_state_size, work_size
+from ..kernel.records import PACKET, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
 from .compiling import ready
-from .results import MergeError, Result, from_tallies, stack_wavelengths, sun_of
+from .results import (MergeError, Result, add_parts, from_tallies, stack_wavelengths,
+                      sun_of)
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
 PACKET_STRIDE = 256 // PACKET.itemsize    # packets of two batches 256 bytes apart
 RNG_STRIDE = 16                           # random states 128 bytes apart (written at every draw)
+RNG_WORDS = 2 * STATE_WORDS               # a batch's two streams (kernel/rng.py batch_state)
 CALL_SECONDS = 0.2      # aimed length of one kernel call: the latency of a stop or a checkpoint
 FIRST_BUDGET = 1 << 12  # work units (photons + scattering events) of a batch's first call
 MIN_BUDGET = 1 << 8
@@ -164,11 +166,13 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     n_layers = len(config.water.layers)
     config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
     depths = config.tallies.depths_m
-    # each batch's state between calls: random stream, next photon (-1: not begun), entered sun
-    # beam (weight per sun packet, direction), scattering events, tally row
+    # each batch's state between calls: random streams (the photons', then the inelastic
+    # emissions'), next photon (-1: not begun), entered sun beam (weight per sun packet,
+    # direction), scattering events, tally row
     rngs = np.zeros((n_batches, RNG_STRIDE), dtype=np.uint64)
     for b in range(n_batches):
         rngs[b, :STATE_WORDS] = batch_state(config.seed, first_batch + b)
+        rngs[b, STATE_WORDS:RNG_WORDS] = batch_state(config.seed, first_batch + b, 1)
     beams = np.zeros((n_batches, 4))
     beams[:, 3] = 1.0
     next_photon = np.full(n_batches, -1, dtype=np.int64)
@@ -179,8 +183,8 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         _restore(resume_state, first_batch, n_batches, sc.grid, rngs, beams, next_photon,
                  events, tallies)
     packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
-    # room for split packets waiting their turn (scratch, one per batch; unused without splitting)
-    stack_rows = SPLIT_STACK_ROWS if sc.splitting else 1
+    # room for split copies and emitted packets waiting their turn (scratch, one per batch)
+    stack_rows = sc.stack_rows
     stacks = np.zeros((n_batches, stack_rows), dtype=PACKET)
     # the spectral state of the packet (row 0) and of its split copies (kernel/packet.py), and
     # one event's scratch, each batch's on cache lines of its own
@@ -188,6 +192,9 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     states = np.zeros((n_batches, stack_rows + 1, row_floats(packet_state_size(n_wl))))
     work = np.zeros((n_batches, row_floats(work_size(n_wl))))
     raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
+    # the parts of the tally row: the elastic light's, then each inelastic process's
+    part_names = ["elastic"] + ([name for name, _ in config.water.inelastic.processes()]
+                                if config.water.inelastic is not None else [])
     ed0, diffuse, _ = illumination_spectrum(config)
     # the resolved scene, with what a spectrum model or table gave (Ed0, diffuse share) noted
     scene_yaml = config_to_yaml(config, (ed0, diffuse))
@@ -206,9 +213,10 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                     return
                 t = time.perf_counter()
                 next_photon[b], n_events = trace(*args, n_per_batch, next_photon[b], budget,
-                                                 rngs[b, :STATE_WORDS], beams[b], tallies[b],
-                                                 packets[b, :1], stacks[b], states[b],
-                                                 work[b])
+                                                 rngs[b, :STATE_WORDS],
+                                                 rngs[b, STATE_WORDS:RNG_WORDS], beams[b],
+                                                 tallies[b], packets[b, :1], stacks[b],
+                                                 states[b], work[b])
                 events[b] += n_events
             budget = next_budget(budget, time.perf_counter() - t)
 
@@ -224,7 +232,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             # the kernel's to change, a file's state stays readable
             scores = tally_arrays(sc.grid, tallies)
             state = {"batch": np.array(begun, dtype=np.int64) + first_batch,
-                     "rng": np.empty((len(begun), STATE_WORDS), dtype=np.uint64),
+                     "rng": np.empty((len(begun), RNG_WORDS), dtype=np.uint64),
                      "beam": np.empty((len(begun), 4)),
                      "next_photon": np.empty(len(begun), dtype=np.int64),
                      "events": np.empty(len(begun), dtype=np.int64)}
@@ -232,7 +240,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                           for name, values in scores.items()})
             for k, b in enumerate(begun):
                 with locks[b]:
-                    state["rng"][k] = rngs[b, :STATE_WORDS]
+                    state["rng"][k] = rngs[b, :RNG_WORDS]
                     state["beam"][k] = beams[b]
                     state["next_photon"][k] = next_photon[b]
                     state["events"][k] = events[b]
@@ -261,19 +269,35 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
             "illumination_Ed0": np.asarray(ed0, dtype=np.float64),
             "illumination_diffuse_fraction": np.asarray(diffuse, dtype=np.float64),
         }
+        if len(part_names) > 1:
+            # the outputs' parts (results.add_parts), and the wavelengths traced for the
+            # excitation of inelastic light beyond those asked for (config/inelastic.py)
+            attrs["inelastic_parts"] = " ".join(part_names)
+            attrs["wavelengths_added_nm"] = np.asarray(config.added_wavelengths, dtype=float)
         reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
         per_wavelength = []
         for k, raw in enumerate(raws):
-            part = {name: values[:done] for name, values in raw.items()}
-            part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+            parts = [{name.removeprefix(f"part{i}/"): values[:done]
+                      for name, values in raw.items()
+                      if (name.startswith(f"part{i}/") if i else "/" not in name)}
+                     for i in range(len(part_names))]
+            for part in parts:
+                part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
+            whole = {name: sum(part[name] for part in parts) for name in parts[0]}
             if reflected is not None:
-                part["reflected_local"] = scene.surface.reflected_at(reflected, ed0[k],
-                                                                     diffuse[k])
-            per_wavelength.append(from_tallies(
-                part, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
-                config.tallies.radiance, attrs, config.tallies.local_directions_deg,
-                sc.local_rows, config.nadir_local, sun_of(config)))
+                parts[0]["reflected_local"] = whole["reflected_local"] = \
+                    scene.surface.reflected_at(reflected, ed0[k], diffuse[k])
+
+            def derived(values):
+                return from_tallies(
+                    values, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
+                    config.tallies.radiance, attrs, config.tallies.local_directions_deg,
+                    sc.local_rows, config.nadir_local, sun_of(config), len(parts) > 1)
+            result = derived(whole)
+            if len(parts) > 1:
+                add_parts(result, {name: derived(part) for name, part in zip(part_names, parts)})
+            per_wavelength.append(result)
         # one wavelength: the monochromatic layout (no wavelength dimension)
         result = per_wavelength[0] if n_wl == 1 else \
             stack_wavelengths(per_wavelength, config.wavelengths)
@@ -346,7 +370,8 @@ def _restore(state: dict[str, np.ndarray], first_batch: int, n_batches: int,
         if not 0 <= b < n_batches:
             raise MergeError(f"stored unfinished batch {batch} is outside {first_batch} .. "
                              f"{first_batch + n_batches - 1}")
-        rngs[b, :STATE_WORDS] = state["rng"][k]
+        # (a file from before the second stream holds the first only: the second starts anew)
+        rngs[b, :state["rng"].shape[1]] = state["rng"][k]
         beams[b] = state["beam"][k]
         next_photon[b] = state["next_photon"][k]
         events[b] = state["events"][k]

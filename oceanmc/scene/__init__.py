@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import config as cfg
 from .. import optics
-from ..kernel.records import ESTIMATOR, merge, record
+from ..kernel.records import ESTIMATOR, SPLIT_STACK_ROWS, merge, record
 from . import bottom, estimates, grid, medium, sky, surface
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
@@ -42,11 +42,15 @@ class Scene:
 
     @property
     def tally_size(self) -> int:
-        return int(self.grid[0]["size"])
+        """Floats of one batch's tally row: n_parts parts of `size` (records.py GRID)."""
+        return int(self.grid[0]["size"]) * int(self.grid[0]["n_parts"])
 
     @property
-    def splitting(self) -> bool:
-        return bool(self.estimator[0]["splitting"])
+    def stack_rows(self) -> int:
+        """Rows of the stack that split copies and emitted packets wait on (one, unused,
+        without either)."""
+        uses = self.estimator[0]["splitting"] or self.medium[0]["n_channels"] > 1
+        return SPLIT_STACK_ROWS if uses else 1
 
 
 def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
@@ -57,7 +61,8 @@ def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
                   max_events=int(est.max_events),
                   split_weight=float(est.split_weight or np.inf),
                   splitting=int(est.split_weight is not None),
-                  upward=int(upward.max(initial=0.0) > 0.0))
+                  upward=int(upward.max(initial=0.0) > 0.0),
+                  emission_weight=float(est.emission_weight))
 
 
 def build(config: cfg.SceneConfig) -> Scene:

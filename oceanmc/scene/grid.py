@@ -96,7 +96,8 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     (a depth profile's sublayers each absorb into a budget column of their own). The row holds
     scores only (the packet's state is the packet's: kernel/packet.py), every score with its
     wavelengths side by side; bottom_shares: each wavelength's bottom reflectance relative to
-    the packed BRDF's (default 1)."""
+    the packed BRDF's (default 1). The row holds one part of `size` scores per collision
+    channel: the elastic light's, then each inelastic process's."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
     n_depths = len(depths)
@@ -121,8 +122,10 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     _, diffuse, _ = optics.illumination_spectrum(config)
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
+    inelastic = config.water.inelastic
+    n_parts = 1 + (len(inelastic.processes()) if inelastic is not None else 0)
     rec = record(
-        GRID, n_wl=n_wl, scores=shared_size,
+        GRID, n_wl=n_wl, n_parts=n_parts, scores=shared_size,
         source_q=f.add(source_q),
         bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
@@ -138,35 +141,44 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
 
 
 def tally_arrays(grid_record: np.ndarray, tallies: np.ndarray) -> dict[str, np.ndarray]:
-    """The scores of the per-batch tally rows (batch, size) as named views into them, batch
-    axis first and wavelength axis last: flux (level, 4, wl), radiance (level, theta, phi, wl),
-    local (level, direction, wl), cap (level, wl), budget (n_budget, wl). Only the GRID
-    record's score offsets are read: what else the row holds, and where, is the kernel's
-    business. Writing into the views writes the rows (write_tally_arrays)."""
+    """The scores of the per-batch tally rows (batch, n_parts x size) as named views into
+    them, batch axis first and wavelength axis last: flux (level, 4, wl), radiance (level,
+    theta, phi, wl), local (level, direction, wl), cap (level, wl), budget (n_budget, wl); the
+    elastic light's under these names, part k's (light inelastic channel k emitted) under
+    `part{k}/` these names. Only the GRID record's score offsets are read: what else the row
+    holds, and where, is the kernel's business. Writing into the views writes the rows
+    (write_tally_arrays)."""
     g = grid_record[0]
     nb = tallies.shape[0]
     n_levels = int(g["n_depths"]) + 2
     n_wl = int(g["n_wl"])
     scores = int(g["scores"])
+    size = int(g["size"])
+    out = {}
+    for k in range(int(g["n_parts"])):
+        prefix = f"part{k}/" if k else ""
 
-    def part(at, shape):
-        """The score array at row offset `at`, its wavelengths side by side."""
-        length = int(np.prod(shape)) * n_wl
-        # a slice of each row split into axes: a view (numpy reshapes a contiguous axis
-        # without copying), so that reading it later sees what the kernel has added since
-        return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))
+        def part(at, shape):
+            """The score array at row offset `at` of part k, its wavelengths side by side."""
+            length = int(np.prod(shape)) * n_wl
+            at += k * size
+            # a slice of each row split into axes: a view (numpy reshapes a contiguous axis
+            # without copying), so that reading it later sees what the kernel has added since
+            return tallies[:, at:at + length].reshape((nb,) + shape + (n_wl,))
 
-    def spectral(name, shape):
-        """A score of the per-wavelength layout: GRID gives one wavelength's offset
-        (kernel/tally.py spectral_at)."""
-        return part(scores + (int(g[name]) - scores) * n_wl, shape)
+        def spectral(name, shape):
+            """A score of the per-wavelength layout: GRID gives one wavelength's offset
+            (kernel/tally.py spectral_at)."""
+            return part(scores + (int(g[name]) - scores) * n_wl, shape)
 
-    return {"flux": spectral("flux", (n_levels, 4)),
-            "radiance": spectral("radiance", (n_levels, int(g["theta_cols"]),
-                                              int(g["phi_cols"]))),
-            "local": part(int(g["local"]), (n_levels - 1, int(g["n_dirs"]))),
-            "cap": part(int(g["cap"]), (n_levels - 1,)),
-            "budget": spectral("budget", (int(g["n_budget"]),))}
+        out.update({
+            prefix + "flux": spectral("flux", (n_levels, 4)),
+            prefix + "radiance": spectral("radiance", (n_levels, int(g["theta_cols"]),
+                                                       int(g["phi_cols"]))),
+            prefix + "local": part(int(g["local"]), (n_levels - 1, int(g["n_dirs"]))),
+            prefix + "cap": part(int(g["cap"]), (n_levels - 1,)),
+            prefix + "budget": spectral("budget", (int(g["n_budget"]),))})
+    return out
 
 
 def write_tally_arrays(grid_record: np.ndarray, arrays: dict[str, np.ndarray],

@@ -177,8 +177,9 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
     values per layer; optical depths wavelength-major (the local estimates read them); the
     Column's albedo is the largest of each layer's wavelengths' (it caps the upward bias, which
-    a spectral walk applies at every wavelength: kernel/upward.py). One collision channel,
-    elastic scattering, takes all of b (kernel/channels/)."""
+    a spectral walk applies at every wavelength: kernel/upward.py). Collision channels
+    (kernel/channels/): elastic scattering, which takes all of b, then the inelastic processes
+    of water.inelastic (optics/inelastic/)."""
     layers = optics.column_iops(config)
     n_wl = len(config.wavelengths)
     if n_wl > 1:
@@ -256,10 +257,11 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     up_cos = math.cos(cone)
     up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
 
+    inelastic = optics.inelastic.channels(config, layers, optics.illumination_spectrum(config)[0])
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
         MEDIUM, n_planes=len(plane_z), n_layers=len(layers), n_wl=n_wl,
-        n_comps=len(comp_model), n_channels=1, up_cos=up_cos,
+        n_comps=len(comp_model), n_channels=1 + len(inelastic), up_cos=up_cos,
         plane_z=f.add(plane_z), plane_tau=f.add(plane_tau), layer_c=f.add(layer_c),
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
@@ -281,6 +283,11 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         tab_guide=i.add(np.concatenate(guide_parts) if guide_parts else np.zeros(0, np.int64)),
         mix_ptr=i.add(mix_ptr), mix_comp=i.add(mix_comp), mix_at=i.add(mix_at),
         mix_coef=f.add(mix_coef),
-        channel_b=f.add(layer_b), channel_model=i.add([registry.CHANNEL["elastic"][0]]))
+        channel_model=i.add([registry.CHANNEL[name][0]
+                             for name in ["elastic"] + [ch.name for ch in inelastic]]),
+        channel_beta=f.add([0.0] + [ch.phase_beta for ch in inelastic]),
+        channel_sigma=f.add([ch.sigma for ch in inelastic]),
+        channel_reach=f.add([ch.transfer.sum(axis=1) for ch in inelastic]),
+        channel_transfer=f.add([ch.transfer for ch in inelastic]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
     return rec, f.array(), i.array(), column

@@ -1,34 +1,28 @@
-"""A collision's channel: chosen by its share of the scattering coefficient, then run."""
+"""A collision's channels: the elastic one turns the packet; each inelastic one (Raman
+scattering, fluorescence) takes its share of every wavelength and emits a packet of its own."""
 from ..compile import internal
-from ..models import CHANNEL_ELASTIC
-from ..rng import uniform
-from . import elastic
+from .. import spectral
+from . import elastic, inelastic
 
 
 @internal
-def choose(medium, floats, layer, h, rng):
-    """The channel of a collision in `layer` with hero wavelength h, drawn with probability
-    b_channel / b (MEDIUM channel_b); a scene of one channel draws nothing."""
-    n = medium.n_channels
-    if n == 1:
-        return 0
-    n_wl = medium.n_wl
-    row = medium.channel_b + layer * n * n_wl + h
-    total = 0.0
-    for k in range(n):
-        total += floats[row + k * n_wl]
-    left = uniform(rng) * total
-    for k in range(n - 1):
-        left -= floats[row + k * n_wl]
-        if left < 0.0:
-            return k
-    return n - 1
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
+    """The elastic channel, every scene's (scene/medium.py packs it first as channel 0): the
+    packet's new direction and weights."""
+    elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
 
 
 @internal
-def scatter(channel, medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
-    """Runs channel `channel` of the scene (its model: MEDIUM channel_model). Channel 0 is
-    every scene's elastic scattering (scene/medium.py packs it first), run without reading
-    its model."""
-    if channel == 0 or ints[medium.channel_model + channel] == CHANNEL_ELASTIC:
-        elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
+def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack, stack_ps,
+         n_stacked, p, ps, layer, rng_emitted):
+    """Every inelastic channel (1 .. n_channels - 1; their models: MEDIUM channel_model, all
+    run by channels/inelastic.py) of a collision of packet p, before its implicit capture.
+    Returns the new stack height."""
+    if medium.n_channels == 1:
+        return n_stacked
+    spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl])
+    for channel in range(1, medium.n_channels):
+        n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
+                                   tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,
+                                   rng_emitted)
+    return n_stacked

@@ -24,6 +24,9 @@ class Contribution:
     b: np.ndarray          # (n_wl,) 1/m
     phases: tuple          # schema phase configs
     weights: np.ndarray    # (n_wl, n_phases): share of this component's b by phase; rows sum to 1
+    # (n_wl,) 1/m: the part of a absorbed by phytoplankton, which fluoresces
+    # (optics/inelastic/); None: none
+    a_phytoplankton: np.ndarray | None = None
 
 
 def per_wavelength(value, n_wl: int) -> np.ndarray:

@@ -27,7 +27,8 @@ Backscatter: two populations (Morel et al. 2002): a share alpha = 0.855 (0.5 - 0
 Beyond 400-700 nm (the range of the Bricaud table): HydroLight extends A_p and E_p to 300 and
 1000 nm with a data file (user-selectable ultraviolet absorption) that is not published with its
 numbers and is not shipped here. oceanmc continues a_p(l; Chl) exponentially from each end of the
-table with the log-slope the table itself has over its last 10 nm at that Chl (EDGE_NM), never
+table with the log-slope the table itself has over its last 10 nm at that Chl (chlorophyll.py
+bricaud), never
 holding it flat: in the red a_p falls on, as it does beyond the 676 nm chlorophyll peak; in the
 ultraviolet (350-400 nm) it falls slowly (a_p(350) = 0.69 a_p(400) at Chl 1), where CDOM, which
 is exponential everywhere and needs no table, already outweighs the particles (0.2 a_p(440)
@@ -39,9 +40,8 @@ import math
 
 import numpy as np
 
-from ..tables import packaged
 from . import Contribution, fournier_forand_by_ratio
-from .chlorophyll import BRICAUD
+from .chlorophyll import bricaud
 
 F_CDOM = 0.2
 S_CDOM = 0.014          # 1/nm
@@ -49,41 +49,18 @@ B550_COEF, B550_EXPONENT = 0.416, 0.766
 SMALL_SHARE_COEF = 0.855
 BB_LARGE = 0.002
 BB_SMALL = BB_LARGE + 0.01 / SMALL_SHARE_COEF
-EDGE_NM = 10.0          # the table span whose log-slope continues a_p beyond each end
-
-
-def _coefficients(wavelengths_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A_p and E_p interpolated linearly in the Bricaud table (400-700 nm)."""
-    table = packaged(BRICAUD)
-    nodes = table["wavelength_nm"]
-    return (np.interp(wavelengths_nm, nodes, table["A_p"]),
-            np.interp(wavelengths_nm, nodes, table["E_p"]))
 
 
 def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_p (1/m) at any wavelength, Chl > 0: the Bricaud table inside 400-700 nm, its edge
-    log-slope at that Chl continued outside (in logarithms, which do not underflow)."""
-    nodes = packaged(BRICAUD)["wavelength_nm"]
-    low, high = float(nodes[0]), float(nodes[-1])
-    wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    a_coef, e_coef = _coefficients(np.clip(wl, low, high))
-    out = a_coef * chl ** e_coef
-    for edge, inner, outside in ((low, low + EDGE_NM, wl < low), (high, high - EDGE_NM, wl > high)):
-        if outside.any():
-            a_pair, e_pair = _coefficients(np.array([edge, inner]))
-            log_pair = np.log(a_pair) + e_pair * math.log(chl)     # ln a_p at edge and inner
-            slope = (log_pair[0] - log_pair[1]) / (edge - inner)  # d ln a_p / d lambda
-            out[outside] = np.exp(log_pair[0] + slope * (wl[outside] - edge))
-    return out
+    """a_p (1/m) at any wavelength, Chl > 0: A_p Chl^E_p, continued beyond the table's
+    400-700 nm by chlorophyll.bricaud."""
+    return bricaud(chl, wavelengths_nm, "A_p", "E_p")
 
 
 def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_phi = A_phi Chl^E_phi (Bricaud et al. 1998), 400-700 nm: the living part of a_p (for the
-    README's shares of absorption, tests/test_case1.py; the model itself uses a_p)."""
-    table = packaged(BRICAUD)
-    nodes = table["wavelength_nm"]
-    return (np.interp(wavelengths_nm, nodes, table["A_phi"])
-            * chl ** np.interp(wavelengths_nm, nodes, table["E_phi"]))
+    """a_phi = A_phi Chl^E_phi (Bricaud et al. 1998), continued likewise: the living part of
+    a_p, which fluoresces (optics/inelastic/)."""
+    return bricaud(chl, wavelengths_nm)
 
 
 def cdom_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
@@ -119,4 +96,5 @@ def iops(component, wavelengths_nm: np.ndarray, where: str) -> Contribution:
     a = particle_absorption(chl, wavelengths_nm) + cdom_absorption(chl, wavelengths_nm)
     alpha = small_share(chl)
     return Contribution(a, scattering(chl, wavelengths_nm), phases,
-                        np.tile([1.0 - alpha, alpha], (n_wl, 1)))
+                        np.tile([1.0 - alpha, alpha], (n_wl, 1)),
+                        a_phytoplankton=phytoplankton_absorption(chl, wavelengths_nm))

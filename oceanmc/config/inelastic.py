@@ -1,0 +1,121 @@
+"""Inelastic light: `water.inelastic: {raman: {...}, chlorophyll_fluorescence: {...}}`, each
+optional, an empty mapping the published defaults (DESIGN.md 7.4; optics/inelastic/ computes
+them, kernel/channels/inelastic.py moves the light).
+
+The wavelength grid must hold the light that excites what is reported: Raman light at 400 nm
+comes from about 352 nm, chlorophyll fluorescence is excited from 370 nm. transport_grid() gives
+the grid the run traces: the requested wavelengths, extended below them down to the lowest
+excitation wavelength needed and with no gap wider than max_step_nm in the excitation range.
+The run then reports every traced wavelength and its summary names those it added."""
+from __future__ import annotations
+
+import math
+from typing import Annotated, Optional
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from .base import _Strict
+
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+
+# Walrafen's four Gaussians reach below 1e-6 of their peak outside these wavenumber shifts
+# (1/cm; centres 3250-3625, widths 140-210 FWHM: the outer ones +-5 standard deviations)
+RAMAN_SHIFT_RANGE = (2800.0, 3950.0)
+
+
+class Raman(_Strict):
+    """Raman scattering by water molecules. b_R(l') = b488_per_m (488 / l')^exponent, the loss
+    at the excitation wavelength l' (HydroLight's default 2.6e-4 1/m and 5.5, energy units;
+    Bartlett et al. 1998, Appl. Opt. 37, 3324, measured 2.7e-4 and 5.3 in photon units);
+    Walrafen's (1967) four-Gaussian wavenumber redistribution; phase function
+    (1 + phase_beta cos^2) normalised, phase_beta = (1 - rho) / (1 + 3 rho) = 0.55 for the
+    depolarisation ratio rho = 0.17 (Mobley 1994, Light and Water, 5.13)."""
+    b488_per_m: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 2.6e-4
+    exponent: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 5.5
+    phase_beta: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.55
+
+    def excitation_nm(self, emission_nm: float) -> tuple[float, float]:
+        low, high = RAMAN_SHIFT_RANGE
+        return 1e7 / (1e7 / emission_nm + high), 1e7 / (1e7 / emission_nm + low)
+
+    def emits_at(self, emission_nm: float) -> bool:
+        return True
+
+
+class ChlorophyllFluorescence(_Strict):
+    """Chlorophyll fluorescence: a share quantum_yield of the photons that phytoplankton
+    absorb between excitation_nm[0] and excitation_nm[1] is re-emitted isotropically, in a
+    Gaussian of standard deviation sigma_nm about peak_nm (HydroLight's defaults: 0.02, 685 nm,
+    10.6 nm, 370-690 nm; published yields 0.005-0.07; Mobley 1994, Light and Water, 5.14)."""
+    quantum_yield: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.02
+    peak_nm: Annotated[float, Field(ge=300.0, le=1000.0, allow_inf_nan=False)] = 685.0
+    sigma_nm: Annotated[float, Field(ge=0.1, le=100.0, allow_inf_nan=False)] = 10.6
+    excitation_range_nm: tuple[Positive, Positive] = (370.0, 690.0)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "ChlorophyllFluorescence":
+        low, high = self.excitation_range_nm
+        if not low < high:
+            raise ValueError(f"excitation_range_nm = [{low}, {high}]; allowed: a lower bound "
+                             "below the upper one, in nm")
+        return self
+
+    def excitation_nm(self, emission_nm: float) -> tuple[float, float]:
+        return self.excitation_range_nm
+
+    def emits_at(self, emission_nm: float) -> bool:
+        """Whether the emission Gaussian reaches emission_nm (within 6 standard deviations)."""
+        return abs(emission_nm - self.peak_nm) <= 6.0 * self.sigma_nm
+
+
+class Inelastic(_Strict):
+    """The inelastic processes of the water; each off unless given. max_step_nm: the widest
+    gap the traced grid may have where it excites light (the excitation spectrum is
+    interpolated linearly between traced wavelengths)."""
+    raman: Optional[Raman] = None
+    chlorophyll_fluorescence: Optional[ChlorophyllFluorescence] = None
+    max_step_nm: Annotated[float, Field(ge=0.5, le=50.0, allow_inf_nan=False)] = 10.0
+
+    def processes(self) -> list[tuple[str, object]]:
+        """(name, settings) of the processes that are on, in the order of their channels."""
+        return [(name, getattr(self, name)) for name in PROCESSES
+                if getattr(self, name) is not None]
+
+
+# the processes in channel order (kernel/channels/: channel k + 1 is process k)
+PROCESSES = ("raman", "chlorophyll_fluorescence")
+
+
+def transport_grid(requested: np.ndarray, inelastic: Inelastic) -> np.ndarray:
+    """The wavelengths a run with inelastic light traces: the requested ones, and below and
+    between them what the excitation of the requested ones needs (see the module)."""
+    low = math.inf
+    high = -math.inf
+    for _, process in inelastic.processes():
+        for emission in requested:
+            if process.emits_at(float(emission)):
+                lo, hi = process.excitation_nm(float(emission))
+                low, high = min(low, lo), max(high, min(hi, float(emission)))
+    if not math.isfinite(low):
+        return requested
+    step = inelastic.max_step_nm
+    diffs = np.diff(requested)
+    regular = len(requested) > 1 and np.allclose(diffs, diffs[0], rtol=1e-9) \
+        and diffs[0] <= step
+    below_step = float(diffs[0]) if regular else step
+    nodes = list(requested)
+    first = float(requested[0])
+    k = 1
+    while first - (k - 1) * below_step > low:
+        nodes.append(first - k * below_step)
+        k += 1
+    nodes = np.unique(np.round(np.array(nodes, dtype=np.float64), 9))
+    # no gap wider than step inside the excitation range
+    filled = [nodes[0]]
+    for a, b in zip(nodes[:-1], nodes[1:]):
+        if b - a > step * (1.0 + 1e-9) and a < high and b > low:
+            pieces = math.ceil((b - a) / step)
+            filled += list(a + (b - a) * np.arange(1, pieces) / pieces)
+        filled.append(b)
+    return np.array(filled, dtype=np.float64)

@@ -1,0 +1,116 @@
+"""Inelastic channels (Raman scattering, fluorescence: optics/inelastic/ packs them): at every
+collision, each process takes from every wavelength j what it takes in expectation, x_j =
+w_j sigma_j (w_j the collision's weight per unit coefficient, spectral.collision_density;
+sigma_j the process's coefficient in the layer), and emits at each wavelength i
+E_i = sum_j x_j T_ji (T the process's transfer: redistribution, photon-to-energy factor
+lambda_j / lambda_i, and the source spectrum's ratio Ed0_j / Ed0_i, since a packet's weight at
+a wavelength is a share of that wavelength's Ed0). The emission starts a packet of its own at
+the collision point (a new source of light, as the sun's photons are: hero wavelength drawn
+anew, K = 1), in a direction drawn from the process's phase function about the incident
+direction, tallied in the process's part of the tally row (p.part); it waits on the split stack
+and is traced after the packet that emitted it, within the same photon history. The emitting
+packet goes on elastically: the process's loss is in its attenuation (Raman) or absorption
+(fluorescence), and the budget moves x_j from absorbed to shifted out.
+
+An emission lighter than the estimator's emission_weight is made with probability
+E / emission_weight and then carries emission_weight (Russian roulette on the emission,
+unbiased; Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2), so that a collision costs the
+O(n^2) emission spectrum only when it emits, and the emitted packets of a history stay few
+(a packet emitted by an emitted packet weighs about sigma / c of it, so their number falls
+geometrically). Its draws come from the batch's second stream (rng_emitted), so that the elastic
+light's draws, and with them the elastic part of every output, are those of the same scene
+without the inelastic processes (whose loss is kept as absorption)."""
+from .. import local_estimate, packet
+from ..compile import internal
+from ..geometry import turn
+from ..models import BUDGET_LAYERS, BUDGET_SHIFTED_IN, BUDGET_SHIFTED_OUT, BUDGET_TRUNCATED
+from ..phase import quadratic
+from ..rng import uniform
+from ..tally import spectral_at
+
+
+@internal
+def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
+         stack_ps, n_stacked, p, ps, layer, rng_emitted):
+    """Channel `channel` (1 ..) of a collision of packet p in `layer`, whose weights per unit
+    coefficient are work[:n] (spectral.collision_density): books what it takes from each
+    wavelength in p's part of the tally row, and, when it emits, books what it gives in its
+    own part, scores the local estimates of the emission (local_estimate.at_emission) and
+    pushes the emitted packet on the stack. Returns the new stack height."""
+    n = grid.n_wl
+    density = work[:n]
+    taken = work[n:2 * n]
+    k = channel - 1
+    sigma_at = medium.channel_sigma + (k * medium.n_layers + layer) * n
+    reach_at = medium.channel_reach + k * n
+    part_size = grid.size
+    own = p.part * part_size
+    absorbed = own + spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
+    out = own + spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT)
+    total = 0.0
+    for j in range(n):
+        x = density[j] * floats[sigma_at + j]
+        taken[j] = x
+        tally_row[absorbed + j] -= x
+        tally_row[out + j] += x
+        total += x * floats[reach_at + j]
+    if total <= 0.0:
+        return n_stacked
+    target = ctrl.emission_weight
+    if total < target:
+        if uniform(rng_emitted) * target >= total:
+            return n_stacked
+        scale = target / total
+    else:
+        scale = 1.0
+    emission = work[2 * n:3 * n]
+    transfer_at = medium.channel_transfer + k * n * n
+    for i in range(n):
+        emission[i] = 0.0
+    for j in range(n):
+        x = taken[j]
+        if x > 0.0:
+            row = floats[transfer_at + j * n:transfer_at + (j + 1) * n]
+            for i in range(n):
+                emission[i] += x * row[i]
+    part = channel
+    child_part = part * part_size
+    shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)
+    heaviest = 0
+    for i in range(n):
+        emission[i] *= scale
+        tally_row[shifted_in + i] += emission[i]
+        if emission[i] > emission[heaviest]:
+            heaviest = i
+    if est.directions_on or est.cap_on:
+        # the light the emission sends straight to the levels above and out (the emitted
+        # packet's collisions score what it sends after scattering)
+        local_estimate.at_emission(est, grid, medium, surface, floats, ints,
+                                   tally_row[child_part:child_part + part_size], work, p, layer,
+                                   medium.channel_beta + channel, rng_emitted)
+    if n_stacked >= stack.shape[0]:
+        # no room left on the stack (SPLIT_STACK_ROWS packets waiting; never seen): the
+        # emission is booked as truncated in its part
+        truncated = child_part + spectral_at(grid, grid.budget + BUDGET_TRUNCATED)
+        for i in range(n):
+            tally_row[truncated + i] += emission[i]
+        return n_stacked
+    child = stack[n_stacked]
+    child_ps = stack_ps[n_stacked]
+    k_view, g, last = packet.weights(grid, child_ps)
+    per_emitted = 1.0 / (total * scale)
+    for i in range(n):
+        k_view[i] = 1.0
+        last[i] = emission[i]
+        g[i] = emission[i] * per_emitted
+    child_ps[packet.free_path_at(grid)] = 0.0
+    cos_t = quadratic.sample(floats[medium.channel_beta + channel:], uniform(rng_emitted))
+    child.ux, child.uy, child.uz = turn(p.ux, p.uy, p.uz, cos_t, uniform(rng_emitted))
+    child.z = p.z
+    child.seg = p.seg
+    child.w = total * scale
+    child.beam = 0
+    child.part = part
+    child.wavelength = min(n - 1, int(uniform(rng_emitted) * n))
+    child.reference = heaviest
+    return n_stacked + 1
