@@ -196,8 +196,9 @@ def single_scattering(wavelengths_nm, depth_m, absorption, *, b488: float = B488
     second and higher Raman orders, an absolute error O((b_R d)^2 E0) (relative O(b_R d) times a
     log factor from grazing paths; second_order_bound() bounds it): in a 2 m layer with
     a ~ 0.02 1/m the higher orders are 14-39% of this at b488 = 2.6e-2 over 450-600 nm, and
-    at most 0.5% (by the bound) at the default 2.6e-4. This is why reference_walk() also returns its once-Raman
-    part. Returns dict(Eu_top, Ed_bottom, Eou_top) of arrays over wavelengths_nm [W m^-2 nm^-1].
+    at most 0.5% (by the bound) at the default 2.6e-4. This is why reference_walk() also
+    returns its once-Raman part. Returns dict(Eu_top, Ed_bottom, Eou_top) of arrays over
+    wavelengths_nm [W m^-2 nm^-1].
     """
     lam = np.atleast_1d(np.asarray(wavelengths_nm, dtype=np.float64))
     d = float(depth_m)
