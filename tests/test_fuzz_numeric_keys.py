@@ -127,6 +127,18 @@ def templates(folder):
                       bottom={"model": "none"}, tallies=SMALL_TALLIES),
         "specular": _mono(bottom={"model": "specular", "reflectance": 0.5},
                           tallies=SMALL_TALLIES),
+        # the grid is extended for the excitation (config/inelastic.py): 370-700 nm traced
+        "inelastic": _mono(
+            wavelengths_nm={"start": 660, "stop": 700, "step": 20}, tallies=SMALL_TALLIES,
+            water={"layers": [{"thickness_m": 2.0, "components": [
+                {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": 1.0}]}],
+                "inelastic": {"raman": {"b488_per_m": 2.6e-4, "exponent": 5.5,
+                                        "phase_beta": 0.55},
+                              "chlorophyll_fluorescence": {
+                                  "quantum_yield": 0.02, "peak_nm": 685, "sigma_nm": 10.6,
+                                  "excitation_range_nm": [370, 690]},
+                              "max_step_nm": 10}},
+            estimator={"emission_weight": 0.01}),
         "bottom_mixture_spectra": _mono(
             wavelengths_nm=[400, 500, 600], tallies=SMALL_TALLIES,
             bottom={"model": "mixture", "components": [
@@ -292,7 +304,7 @@ def test_every_numeric_key_of_the_schema_is_reached(scenes):
 FUZZED: set = set()
 TEMPLATES = ["hg_lambertian", "constituents_minnaert", "sun_spectrl2", "lists_cox_munk_wind",
              "ggx", "ff_hapke_slope", "mixture_lambertian_specular", "files", "deep",
-             "specular", "bottom_mixture_spectra"]
+             "specular", "bottom_mixture_spectra", "inelastic"]
 
 
 @pytest.mark.parametrize("template", TEMPLATES)

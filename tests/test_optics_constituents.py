@@ -71,14 +71,14 @@ def test_chlorophyll_beyond_bricaud_range_continues_the_edge_slope():
     """Outside 400-700 nm a_ph continues exponentially with the table's own log-slope over its
     last 10 nm (chlorophyll.bricaud), never held flat: Raman light at 400 nm is excited near
     350 nm."""
-    wl = np.array([350.0, 380.0, 400.0, 410.0, 700.0, 690.0, 720.0])
-    a = optics.column_iops(scene([{"model": "chlorophyll", "chl_mg_m3": 1.0}], wl))[0].a
+    wl = np.array([350.0, 380.0, 400.0, 410.0, 690.0, 700.0, 720.0])
+    a = optics.column_iops(scene([{"model": "chlorophyll", "chl_mg_m3": 1.0}], list(wl)))[0].a
     slope = (np.log(a[2]) - np.log(a[3])) / (400.0 - 410.0)
     assert np.log(a[0] / a[2]) == pytest.approx(slope * -50.0, rel=1e-9)
     assert np.log(a[1] / a[2]) == pytest.approx(slope * -20.0, rel=1e-9)
-    red = (np.log(a[4]) - np.log(a[5])) / 10.0
-    assert np.log(a[6] / a[4]) == pytest.approx(red * 20.0, rel=1e-9)
-    assert a[0] != a[2] and a[6] != a[4]
+    red = (np.log(a[5]) - np.log(a[4])) / 10.0
+    assert np.log(a[6] / a[5]) == pytest.approx(red * 20.0, rel=1e-9)
+    assert a[0] != a[2] and a[6] != a[5]
 
 
 def test_cdom_particles_constant_and_their_sum():

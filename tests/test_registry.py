@@ -129,7 +129,7 @@ def test_channel_registry_and_dispatch():
 
     import oceanmc
     from oceanmc import scene
-    from oceanmc.kernel import records
+    from oceanmc.kernel import records, spectral
     from oceanmc.kernel.channels import dispatch as channels
     from oceanmc.kernel.rng import batch_state
 
@@ -160,6 +160,8 @@ def test_channel_registry_and_dispatch():
         medium, surface, ctrl, grid, est, floats, ints, packet = sc_arrays
         p = packet[0]
         p.w, p.ux, p.uy, p.uz, p.z, p.seg = 1.0, 0.0, 0.0, 1.0, 0.5, 0
+        spectral.collision_density(medium[0], floats, grid[0], ps, p, 0,
+                                   work[:grid[0].n_wl])
         return channels.emit(medium[0], surface[0], ctrl[0], grid[0], est[0], floats, ints,
                              tally, work, stack, stack_ps, 0, p, ps, 0, rng)
 
@@ -185,5 +187,5 @@ def test_channel_registry_and_dispatch():
                    sc.ints, packet), ps, stack, stack_ps, np.zeros(records.work_size(n)), tally,
                   batch_state(3, 1))
     assert height == 2 and list(stack["part"][:2]) == [1, 2]
-    size = int(sc.grid[0]["size"])
+    size = int(sc.grid[0]["part_size"])
     assert np.count_nonzero(tally[size:2 * size]) and np.count_nonzero(tally[2 * size:])

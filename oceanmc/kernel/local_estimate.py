@@ -21,7 +21,7 @@ A mirror bottom has no density to evaluate, so scenes with one do not use these 
 
 A spectral walk (kernel/spectral.py) scores every wavelength j from the same collision or bottom
 reflection, with its own weight (spectral.collision_weights: the path's weight at j with the
-collision point added, w_j = F_j b_j / mean_k(K_k c_k)), phase function p_j (spectral.phase_values)
+collision point added, w_j = F_j b_j / mean_k(K_k c_k), from spectral.collision_density), phase function p_j (spectral.phase_values)
 and optical depths tau_j: the same next-event estimate, with the one-sample MIS weight of the
 path that led to it. The weights, optical depths and phase values of one event live in the
 batch's scratch row `work` (after a collision's volume scattering function; records.work_size),
@@ -167,15 +167,16 @@ def cap_from_collision(est, floats, grid, tally, above, tau_here, w_scattered, m
 @internal
 def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, layer,
                  w_scattered, rng):
-    """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene)
-    sends into the exact directions (at every level above it and 0+), and the polar-cap
-    average of the nadir-viewing radiance, at every wavelength."""
+    """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene;
+    in a spectral walk its weight per unit coefficient at each wavelength in work[:n_wl],
+    spectral.collision_density) sends into the exact directions (at every level above it and
+    0+), and the polar-cap average of the nadir-viewing radiance, at every wavelength."""
     n = grid.n_wl
     weight, tau, phase_j = scratch(grid, work)
     if n == 1:
         weight[0] = w_scattered
     else:
-        spectral.collision_weights(medium, floats, grid, ps, p, layer, weight)
+        spectral.collision_weights(medium, floats, grid, layer, work[:n], weight)
     z = p.z
     for j in range(n):
         tau[j] = optical_depth(medium, floats, p.seg, layer, z, j)
@@ -201,39 +202,49 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
                 add_to_levels(est, floats, ints, grid, tally, z, tau[j], k,
                               weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
-        # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
-        # between the packet's direction and straight up, and the fraction to the next
-        alpha = math.acos(min(1.0, max(-1.0, -uz)))
-        if alpha < est.fine_end:
-            x = alpha / est.fine_step
-        else:
-            x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
-        i = min(int(x), est.n_alpha - 2)
-        f = x - i
-        table = ints[est.table_of_layer + layer]
-        above = 0   # the tally levels at or above the collision (sorted by depth)
-        while above < grid.n_depths and floats[grid.level_z + above] <= z:
-            above += 1
-        # roulette on the cap's scores: when even the least attenuated wavelength keeps less
-        # than CAP_ROULETTE of its light on the way to the nearest level above (or to the
-        # surface), the collision scores with probability t / CAP_ROULETTE and its scores are
-        # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
-        # which send almost nothing up, cost a comparison instead of n_wl table reads
-        nearest = grid.level_tau + above - 1
-        least = math.inf
-        for j in range(n):
-            dtau = tau[j] - (floats[nearest + j * grid.n_depths] if above > 0 else 0.0)
-            least = min(least, dtau)
-        scale = 1.0
-        kept = math.exp(-least)
-        if kept < CAP_ROULETTE:
-            if uniform(rng) * CAP_ROULETTE >= kept:
-                return
-            scale = CAP_ROULETTE / kept
-        for j in range(n):
-            m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
-            cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j] * scale, m0w,
-                               m1w, m0a, m1a, j)
+        cap_scores(est, grid, floats, ints, tally, weight, tau, z, uz,
+                   ints[est.table_of_layer + layer], 0, n, rng)
+
+
+@internal
+def cap_scores(est, grid, floats, ints, tally, weight, tau, z, uz, table, first, last, rng):
+    """The polar-cap averages (to the levels above depth z and to 0+) of what a point of
+    scattering sends up, for a packet travelling with direction cosine uz, from the cap tables
+    `table` (a layer's phase function, or an inelastic emission's) at the wavelengths
+    first .. last - 1 (weights and optical depths `weight`, `tau`)."""
+    n = grid.n_wl
+    # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
+    # between the packet's direction and straight up, and the fraction to the next
+    alpha = math.acos(min(1.0, max(-1.0, -uz)))
+    if alpha < est.fine_end:
+        x = alpha / est.fine_step
+    else:
+        x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
+    i = min(int(x), est.n_alpha - 2)
+    f = x - i
+    above = 0   # the tally levels at or above the point (sorted by depth)
+    while above < grid.n_depths and floats[grid.level_z + above] <= z:
+        above += 1
+    # roulette on the cap's scores: when even the least attenuated wavelength keeps less
+    # than CAP_ROULETTE of its light on the way to the nearest level above (or to the
+    # surface), the point scores with probability t / CAP_ROULETTE and its scores are
+    # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
+    # which send almost nothing up, cost a comparison instead of n_wl table reads
+    nearest = grid.level_tau + above - 1
+    least = math.inf
+    for j in range(first, last):
+        dtau = tau[j] - (floats[nearest + j * grid.n_depths] if above > 0 else 0.0)
+        least = min(least, dtau)
+    scale = 1.0
+    kept = math.exp(-least)
+    if kept < CAP_ROULETTE:
+        if uniform(rng) * CAP_ROULETTE >= kept:
+            return
+        scale = CAP_ROULETTE / kept
+    for j in range(first, last):
+        m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
+        cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j] * scale, m0w,
+                           m1w, m0a, m1a, j)
 
 
 @internal
@@ -264,56 +275,73 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
     for j in range(n):
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
     from_point(est, grid, surface, floats, ints, bp, tally, weight, tau,
-               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, 0, rng)
+               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng)
 
 
 @internal
-def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, rng):
+def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, table,
+                first, last, rng):
     """An inelastic emission at packet p's collision (its weights at each wavelength in
-    work[2 n:3 n], channels/inelastic.py; its phase function's beta at floats[beta_at]): the
-    radiance it sends in the exact directions and the polar-cap averages (from_point), scored
-    in the emission's part of the tally row `tally`. The collisions of the emitted packet
-    score the rest of its light, as any packet's do."""
+    work[2 n:3 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
+    beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
+    directions (directions_from_point) and the polar-cap averages (cap_scores, as a
+    collision's), scored in the emission's part of the tally row `tally`."""
     n = grid.n_wl
     weight = work[2 * n:3 * n]
     tau = work[3 * n:4 * n]
-    for j in range(n):
+    for j in range(first, last):
         tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
-    from_point(est, grid, surface, floats, ints, floats, tally, weight, tau, p.z, p.ux, p.uy,
-               p.uz, -1, beta_at, rng)
+    if est.directions_on:
+        directions_from_point(est, grid, surface, floats, ints, floats, tally, weight, tau,
+                              p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
+    if est.cap_on:
+        cap_scores(est, grid, floats, ints, tally, weight, tau, p.z, p.uz, table, first, last,
+                   rng)
+
+
+@internal
+def directions_from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, uy,
+                          uz, model, beta_at, first, last, rng):
+    """The radiance a point source at depth z (optical depths tau, weights `weight` at the
+    wavelengths first .. last - 1, none elsewhere; toward() says what it sends, a bottom's
+    BRDF or an emission's phase function) sends in the exact directions."""
+    n = grid.n_wl
+    rough = surface.delta == 0
+    for k in range(est.n_dirs):
+        factor = floats[est.air_factor + k]
+        if rough and factor > 0.0:
+            ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
+            if t > 0.0 and iz < 0.0:
+                f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
+                at = grid.local + (grid.n_depths * est.n_dirs + k) * n
+                for j in range(first, last):
+                    tally[at + j] += (
+                        weight[j] * f * t * math.exp(tau[j] / iz) * factor)
+            continue
+        dx, dy, dz = direction(est, floats, k)
+        f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
+        for j in range(first, last):
+            add_to_levels(est, floats, ints, grid, tally, z, tau[j], k, weight[j] * f, -dz,
+                          j)
 
 
 @internal
 def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, uy, uz, model,
-               beta_at, rng):
-    """The radiance a point source at depth z (optical depths tau, weights `weight` at each
-    wavelength; toward() says what it sends, a bottom's BRDF or an emission's phase function)
-    sends in the exact directions, and the polar-cap average from one direction W drawn
-    uniformly in the cap (an unbiased estimate of the cap average; what it sends is bounded),
+               rng):
+    """The radiance the bottom (BRDF `model`) at depth z sends in the exact directions
+    (directions_from_point), and the polar-cap average from one direction W drawn uniformly in
+    the cap (an unbiased estimate of the cap average; f is bounded for every non-mirror BRDF),
     once in water and once for the air cap, through the surface's transmittance."""
     n = grid.n_wl
+    first, last = 0, n
     if est.directions_on:
-        rough = surface.delta == 0
-        for k in range(est.n_dirs):
-            factor = floats[est.air_factor + k]
-            if rough and factor > 0.0:
-                ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
-                if t > 0.0 and iz < 0.0:
-                    f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
-                    at = grid.local + (grid.n_depths * est.n_dirs + k) * n
-                    for j in range(n):
-                        tally[at + j] += (
-                            weight[j] * f * t * math.exp(tau[j] / iz) * factor)
-                continue
-            dx, dy, dz = direction(est, floats, k)
-            f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
-            for j in range(n):
-                add_to_levels(est, floats, ints, grid, tally, z, tau[j], k, weight[j] * f, -dz, j)
+        directions_from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux,
+                              uy, uz, model, 0, first, last, rng)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
-        f = toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, -oz)
-        for j in range(n):
+        f = toward(model, bp, floats, 0, ux, uy, uz, ox, oy, -oz)
+        for j in range(first, last):
             taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
                 if floats[grid.level_z + level] <= z:
@@ -327,9 +355,9 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
             ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))
             ix, iy, iz, t = from_air_through_rough(surface, floats, ax, ay, mu_a, rng)
             if t > 0.0 and iz < 0.0:
-                f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz) * t / (
+                f = toward(model, bp, floats, 0, ux, uy, uz, ix, iy, iz) * t / (
                     n_water * n_water)
-                for j in range(n):
+                for j in range(first, last):
                     tally[grid.cap + grid.n_depths * n + j] += (
                         weight[j] * f * math.exp(tau[j] / iz))
             return
@@ -337,8 +365,8 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
         t = surface_bsdf.transmittance(surface, mu_w)
         phi = 2.0 * math.pi * uniform(rng)
-        f = toward(model, bp, floats, beta_at, ux, uy, uz, sin_w * math.cos(phi),
+        f = toward(model, bp, floats, 0, ux, uy, uz, sin_w * math.cos(phi),
                    sin_w * math.sin(phi), -mu_w)
-        for j in range(n):
+        for j in range(first, last):
             tally[grid.cap + grid.n_depths * n + j] += (
                 weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

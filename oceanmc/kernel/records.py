@@ -67,7 +67,10 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               tab_start, as long as the table: phase/tabulated.py); mix_ptr (n_layers + 1),
 #               mix_comp, mix_at: the terms of each layer's volume scattering functions, all
 #               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py);
-#               channel_model (n_channels: registry.CHANNEL ids; channel 0 is elastic)
+#               channel_model (n_channels: registry.CHANNEL ids; channel 0 is elastic);
+#               channel_band ((n_channels - 1) x n_wl x 2: each excitation row's emission
+#               columns first .. last - 1), channel_emits ((n_channels - 1) x 2: the columns
+#               any row emits into)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),
@@ -77,7 +80,7 @@ MEDIUM = _record(
                "channel_beta", "channel_sigma", "channel_reach", "channel_transfer"),
     ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
              "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
-             "mix_comp", "mix_at", "channel_model"))
+             "mix_comp", "mix_at", "channel_model", "channel_band", "channel_emits"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann
@@ -114,16 +117,16 @@ SKY = _record(
 #               score with its n_wl wavelengths side by side: the offsets below are those of
 #               one wavelength's layout, and the score at offset i of wavelength j lies at
 #               scores + (i - scores) n_wl + j (tally.py spectral_at: the same address when
-#               n_wl = 1). That is one part, `size` long; the row holds n_parts of them, one
+#               n_wl = 1). That is one part, `part_size` long; the row holds n_parts of them, one
 #               per collision channel: the elastic light's, then each inelastic process's
 #               (the light it emitted; kernel/channels/inelastic.py)
 GRID = _record(
     "n_wl", "n_parts", "scores", "n_depths", "air_level", "surface_level", "mu_cut", "radiance_on",
     "n_theta", "n_phi", "n_lookup", "theta_cols", "phi_cols",
-    "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "size",
+    "flux", "radiance", "local", "cap", "budget", "n_dirs", "n_budget", "part_size",
     ints=("n_wl", "n_parts", "scores", "n_depths", "air_level", "surface_level", "radiance_on", "n_theta",
           "n_phi", "n_lookup", "theta_cols", "phi_cols", "flux", "radiance", "local", "cap",
-          "budget", "n_dirs", "n_budget", "size"),
+          "budget", "n_dirs", "n_budget", "part_size"),
     floats_at=("source_q", "bottom_q", "theta_mu_edges", "phi_edge_cos", "phi_edge_sin",
                "level_z", "level_tau"),
     ints_at=("theta_lookup", "theta_is_cap"))
@@ -131,14 +134,17 @@ GRID = _record(
 # Local (next-event) estimates (kernel/local_estimate.py): exact upward directions, and the
 # nadir polar-cap average (tables from scene/estimates.py).
 #   float pool: dirs (n_dirs x 3), air_factor (n_dirs), cap_m0w, cap_m1w, cap_m0a, cap_m1a
-#               (n_tables x n_alpha x n_wl each; a table holds all wavelengths of a layer),
+#               (n_tables x n_alpha x n_wl each; a table holds all wavelengths of a layer;
+#               after the layers' tables, one per inelastic channel's emission, from
+#               emission_tables on),
 #               level_decay (n_wl x n_depths)
 #   int pool:   in_water (n_dirs), table_of_layer (n_layers)
 ESTIMATES = _record(
     "directions_on", "cap_on", "n_dirs", "n_alpha",
     "fine_end", "fine_step", "coarse_step", "fine_nodes",
     "mu_w", "omega_w", "cos_water", "mu_a", "omega_a", "cos_air", "h", "dh",
-    ints=("directions_on", "cap_on", "n_dirs", "n_alpha", "fine_nodes"),
+    "emission_tables",
+    ints=("directions_on", "cap_on", "n_dirs", "n_alpha", "fine_nodes", "emission_tables"),
     floats_at=("dirs", "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay"),
     ints_at=("in_water", "table_of_layer"))
 

@@ -243,16 +243,15 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
 
 
 @kernel
-def collision_weights(medium, floats, grid, ps, p, layer, weight):
-    """What a collision sends at each wavelength, as a local estimate needs it, without
-    settling: collision_density times b_j (the albedo times c)."""
+def collision_weights(medium, floats, grid, layer, density, weight):
+    """What a collision sends at each wavelength, as a local estimate needs it: its weight per
+    unit coefficient (collision_density) times b_j (the albedo times c)."""
     n = grid.n_wl
-    collision_density(medium, floats, grid, ps, p, layer, weight)
     row = layer * n
     albedo = floats[medium.layer_albedo + row:medium.layer_albedo + row + n]
     c = floats[medium.layer_c + row:medium.layer_c + row + n]
     for j in range(n):
-        weight[j] *= albedo[j] * c[j]
+        weight[j] = density[j] * albedo[j] * c[j]
 
 
 @kernel

@@ -203,8 +203,12 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, tally_row, ps
     tally: the packet's part of the tally row tally_row. Returns (alive, optical depth to the
     next collision, stack height)."""
     albedo = floats[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
-    if (est.directions_on or est.cap_on) and albedo > 0.0:
-        # (a spectral walk settles there: p.w may change)
+    estimates = (est.directions_on or est.cap_on) and albedo > 0.0
+    if grid.n_wl > 1 and (estimates or medium.n_channels > 1):
+        # the collision's weight per unit coefficient at every wavelength, which the local
+        # estimates (times b) and the inelastic channels (times theirs) read
+        spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl])
+    if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
     n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work,
@@ -359,7 +363,10 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
     state states[0]; the stack's rows k are stack[k] and states[k + 1]; work is one event's
     scratch (records.work_size). The sky's share is stratified: round(f n)
     packets come from the sky and carry f n / n_sky each, the rest from the sun. A photon's
-    split copies (stack) are traced before the next photon. The records come as one-row
+    split copies and the packets its inelastic processes emit (channels/inelastic.py) wait on
+    the stack and are traced before the next photon. The tally row holds one part per
+    collision channel, each grid.part_size long: the elastic light's, then each process's (a
+    packet scores in its part, p.part). The records come as one-row
     arrays, the scene's tables as one float pool and one int pool (kernel/records.py); the GIL
     is released, so batches run in parallel threads."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
@@ -401,7 +408,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         packet.launch(p, w, ux, uy, uz, not from_sky)
-        tally = tally_row[:grid.size]
+        tally = tally_row[:grid.part_size]
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
@@ -451,6 +458,6 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
             n_stacked -= 1
             packet.copy(grid, p, ps, stack[n_stacked], stack_ps[n_stacked])
             # an emitted packet scores in its process's part and draws from the second stream
-            tally = tally_row[p.part * grid.size:(p.part + 1) * grid.size]
+            tally = tally_row[p.part * grid.part_size:(p.part + 1) * grid.part_size]
             draws = rng if p.part == 0 else rng_emitted
     return n_photons, events

@@ -43,7 +43,7 @@ class Scene:
     @property
     def tally_size(self) -> int:
         """Floats of one batch's tally row: n_parts parts of `size` (records.py GRID)."""
-        return int(self.grid[0]["size"]) * int(self.grid[0]["n_parts"])
+        return int(self.grid[0]["part_size"]) * int(self.grid[0]["n_parts"])
 
     @property
     def stack_rows(self) -> int:

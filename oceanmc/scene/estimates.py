@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import config as cfg
 from ..kernel.compile import CACHE_DIR
+from ..kernel.phase import quadratic
 from ..kernel.phase.dispatch import component_density
 from ..kernel.records import ESTIMATES, Pool, record
 from ..kernel.surface.dispatch import transmittance
@@ -157,6 +158,23 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
     return _CAP_CACHE[key]
 
 
+def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.ndarray:
+    """(4, n_alpha): the cap moments (as component_moments) of an inelastic emission's phase
+    function (1 + beta cos^2), the same at every wavelength (kernel/channels/inelastic.py)."""
+    key = hashlib.sha1(geometry_key + np.array([beta_quadratic]).tobytes()).digest()
+    if key not in _COMPONENT_MOMENTS:
+        params = np.array([beta_quadratic])
+        table = cap_tables.cumulative(
+            lambda angles: 2.0 * math.pi * np.sin(angles) * np.array(
+                [quadratic.evaluate(params, math.cos(a)) for a in angles]), np.zeros(0))
+        water, air = caps()
+        _COMPONENT_MOMENTS[key] = np.array(
+            [*cap_tables.cap_moments(table, water),
+             *(cap_tables.rough_cap_moments(table, air) if isinstance(air, cap_tables.RoughCap)
+               else cap_tables.cap_moments(table, air))])
+    return _COMPONENT_MOMENTS[key]
+
+
 def rough_mean_cosine(enabled: bool, roughness: float, n: float, beta: float,
                       alphas: np.ndarray, caps) -> float:
     """The mean cosine of the rough sea's lobe K (cap_tables.RoughCap), remembered on disk
@@ -212,6 +230,13 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
             moments.append(layer_cap_moments(medium, mf, mi, layer, caps, key, geometry_key)
                            if enabled else np.zeros((4, len(alphas), n_wl)))
         table_of_layer.append(tables[key])
+    # then one table per inelastic channel's emission (channel k at emission_tables + k - 1)
+    emission_tables = len(moments)
+    m = medium[0]
+    for channel in range(1, int(m["n_channels"])):
+        moments.append(np.repeat(
+            emission_moments(float(mf[m["channel_beta"] + channel]), caps, geometry_key)
+            [:, :, None], n_wl, axis=2) if enabled else np.zeros((4, len(alphas), n_wl)))
     cap_solid_angle = 4.0 * math.pi * math.sin(beta / 2.0) ** 2  # 2 pi (1 - cos beta), stably
     if roughness:
         # K holds the surface's transmission and 1 / dOmega_a: g = exp(-tau/mu) / mu about
@@ -240,5 +265,6 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
         # per wavelength (n_wl x n_depths)
         level_decay=f.add(np.exp(-np.diff(level_tau, axis=1, prepend=level_tau[:, :1])
                                  / mu_w)),
-        in_water=i.add(in_water), table_of_layer=i.add(table_of_layer))
+        in_water=i.add(in_water), table_of_layer=i.add(table_of_layer),
+        emission_tables=emission_tables)
     return rec, f.array(), i.array()

@@ -136,7 +136,7 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
         phi_edge_sin=f.add(np.sin(np.radians(grid.phi_edges[:-1]))),
         level_z=f.add(depths), level_tau=f.add(level_tau),
         theta_lookup=i.add(theta_lookup(mu)), theta_is_cap=i.add(grid.is_cap),
-        n_dirs=n_dirs, n_budget=n_budget, size=size, **layout)
+        n_dirs=n_dirs, n_budget=n_budget, part_size=size, **layout)
     return rec, f.array(), i.array(), grid
 
 
@@ -153,7 +153,7 @@ def tally_arrays(grid_record: np.ndarray, tallies: np.ndarray) -> dict[str, np.n
     n_levels = int(g["n_depths"]) + 2
     n_wl = int(g["n_wl"])
     scores = int(g["scores"])
-    size = int(g["size"])
+    size = int(g["part_size"])
     out = {}
     for k in range(int(g["n_parts"])):
         prefix = f"part{k}/" if k else ""

@@ -173,6 +173,12 @@ def scattering_terms(share: np.ndarray, comp_start: list[int], comp_count: list[
             np.array(at, dtype=np.int64), coefs)
 
 
+def _emits(transfer: np.ndarray) -> list[int]:
+    """The first wavelength a channel emits at and the one after its last."""
+    lit = np.nonzero(transfer.max(axis=0) > 0.0)[0]
+    return [int(lit[0]), int(lit[-1]) + 1] if len(lit) else [0, 0]
+
+
 def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
     """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
     values per layer; optical depths wavelength-major (the local estimates read them); the
@@ -288,6 +294,8 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
         channel_beta=f.add([0.0] + [ch.phase_beta for ch in inelastic]),
         channel_sigma=f.add([ch.sigma for ch in inelastic]),
         channel_reach=f.add([ch.transfer.sum(axis=1) for ch in inelastic]),
-        channel_transfer=f.add([ch.transfer for ch in inelastic]))
+        channel_transfer=f.add([ch.transfer for ch in inelastic]),
+        channel_band=i.add([optics.inelastic.band(ch.transfer) for ch in inelastic]),
+        channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
     return rec, f.array(), i.array(), column

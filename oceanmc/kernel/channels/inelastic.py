@@ -12,12 +12,16 @@ and is traced after the packet that emitted it, within the same photon history. 
 packet goes on elastically: the process's loss is in its attenuation (Raman) or absorption
 (fluorescence), and the budget moves x_j from absorbed to shifted out.
 
-An emission lighter than the estimator's emission_weight is made with probability
-E / emission_weight and then carries emission_weight (Russian roulette on the emission,
-unbiased; Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2), so that a collision costs the
-O(n^2) emission spectrum only when it emits, and the emitted packets of a history stay few
+The light an emission sends straight up (to the tally levels above and out of the water) is
+scored at every collision by local estimates of the expected emission (local_estimate.
+at_emission), as a collision's elastic light is: in clear water most Raman light leaves
+without scattering again. The emitted packet carries the rest. An emission whose mean weight
+per wavelength is below the estimator's emission_weight is made with probability mean /
+emission_weight and then carries that mean (Russian roulette on the emission, unbiased; Kalos &
+Whitlock, Monte Carlo Methods, 2008, 4.2), so that the emitted packets of a history stay few
 (a packet emitted by an emitted packet weighs about sigma / c of it, so their number falls
-geometrically). Its draws come from the batch's second stream (rng_emitted), so that the elastic
+geometrically). The transfer is banded (channel_band), so the emission costs the band's width
+per excitation wavelength, not n. Its draws come from the batch's second stream (rng_emitted), so that the elastic
 light's draws, and with them the elastic part of every output, are those of the same scene
 without the inelastic processes (whose loss is kept as absorption)."""
 from .. import local_estimate, packet
@@ -43,7 +47,7 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     k = channel - 1
     sigma_at = medium.channel_sigma + (k * medium.n_layers + layer) * n
     reach_at = medium.channel_reach + k * n
-    part_size = grid.size
+    part_size = grid.part_size
     own = p.part * part_size
     absorbed = own + spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     out = own + spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT)
@@ -56,25 +60,42 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
         total += x * floats[reach_at + j]
     if total <= 0.0:
         return n_stacked
-    target = ctrl.emission_weight
+    # roulette on the emitted packet, by its mean weight per wavelength (as p.w is one
+    # wavelength's weight): made with probability mean / emission_weight below it
+    target = ctrl.emission_weight * n
+    spawn = True
+    scale = 1.0
     if total < target:
-        if uniform(rng_emitted) * target >= total:
-            return n_stacked
+        spawn = uniform(rng_emitted) * target < total
         scale = target / total
-    else:
-        scale = 1.0
+    estimate = est.directions_on or est.cap_on
+    if not (spawn or estimate):
+        return n_stacked
+    # the emission at each wavelength: T is banded (Raman moves light by 60-120 nm,
+    # fluorescence into 685 +- 64 nm), so each excitation row adds to its band only
     emission = work[2 * n:3 * n]
     transfer_at = medium.channel_transfer + k * n * n
+    band_at = medium.channel_band + 2 * k * n
     for i in range(n):
         emission[i] = 0.0
     for j in range(n):
         x = taken[j]
         if x > 0.0:
-            row = floats[transfer_at + j * n:transfer_at + (j + 1) * n]
-            for i in range(n):
-                emission[i] += x * row[i]
+            row = transfer_at + j * n
+            for i in range(ints[band_at + 2 * j], ints[band_at + 2 * j + 1]):
+                emission[i] += x * floats[row + i]
     part = channel
     child_part = part * part_size
+    if estimate:
+        # the expected emission's light straight to the levels above and out, at every
+        # collision (the emitted packet's collisions score its light after it scatters)
+        local_estimate.at_emission(est, grid, medium, surface, floats, ints,
+                                   tally_row[child_part:child_part + part_size], work, p, layer,
+                                   medium.channel_beta + channel, est.emission_tables + k,
+                                   ints[medium.channel_emits + 2 * k],
+                                   ints[medium.channel_emits + 2 * k + 1], rng_emitted)
+    if not spawn:
+        return n_stacked
     shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)
     heaviest = 0
     for i in range(n):
@@ -82,12 +103,6 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
         tally_row[shifted_in + i] += emission[i]
         if emission[i] > emission[heaviest]:
             heaviest = i
-    if est.directions_on or est.cap_on:
-        # the light the emission sends straight to the levels above and out (the emitted
-        # packet's collisions score what it sends after scattering)
-        local_estimate.at_emission(est, grid, medium, surface, floats, ints,
-                                   tally_row[child_part:child_part + part_size], work, p, layer,
-                                   medium.channel_beta + channel, rng_emitted)
     if n_stacked >= stack.shape[0]:
         # no room left on the stack (SPLIT_STACK_ROWS packets waiting; never seen): the
         # emission is booked as truncated in its part

@@ -34,6 +34,9 @@ from ... import config as cfg
 from ...config import ConfigError
 
 FINE_STEP_NM = 0.02
+# a transfer entry below this share of its row's largest is dropped (the Gaussian tails: Raman
+# lines at more than 6 standard deviations, which hold less than 1e-8 of the light)
+TAIL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -76,7 +79,22 @@ def transfer(process, settings, wavelengths_nm: np.ndarray, sigma_shape: np.ndar
     out = hat @ integrand                                     # (n_exc, n_emi)
     per_sigma = np.divide(1.0, sigma_shape, out=np.zeros_like(sigma_shape),
                           where=sigma_shape > 0.0)
-    return out * per_sigma[:, None] * ed0[:, None] / ed0[None, :]
+    out *= per_sigma[:, None] * ed0[:, None] / ed0[None, :]
+    # the lines' far tails (below TAIL of a row's largest entry) are dropped, so that each
+    # row is a band the kernel reads alone (band)
+    out[out < TAIL * out.max(axis=1, keepdims=True)] = 0.0
+    return out
+
+
+def band(transfer: np.ndarray) -> np.ndarray:
+    """(n_wl, 2): each excitation row's first emission column with light and the one after
+    its last (0, 0 for a row that emits nothing)."""
+    out = np.zeros((transfer.shape[0], 2), dtype=np.int64)
+    for j, row in enumerate(transfer):
+        lit = np.nonzero(row > 0.0)[0]
+        if len(lit):
+            out[j] = lit[0], lit[-1] + 1
+    return out
 
 
 def channels(config: cfg.SceneConfig, layers: list, ed0: np.ndarray) -> list[Channel]:
