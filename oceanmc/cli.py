@@ -350,6 +350,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from .bench import real_scenes
         return real_scenes.main(Path(args.output), args.quick)
 
+    if args.inelastic:
+        from .bench import inelastic
+        return inelastic.main(Path(args.output), args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -457,6 +461,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--real-scenes", action="store_true",
                        help="only the real-scenes section (DIR/real_scenes.md): 31-band Rrs "
                             "of windy Case-1 waters by the defaults, time to 1%% per band")
+    bench.add_argument("--inelastic", action="store_true",
+                       help="only the inelastic section (DIR/inelastic.md): what Raman "
+                            "scattering and chlorophyll fluorescence cost in clear deep water, "
+                            "and their parts' time to 1%%")
     bench.add_argument("--sweep", action="store_true",
                        help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
                             "and 2 Dask workers against a plain loop")

@@ -1,0 +1,148 @@
+"""The inelastic section of `oceanmc bench` (issue 27): what Raman scattering and chlorophyll
+fluorescence cost, and how fast their part of Rrs converges, in clear deep water as users run
+it (a 31-band spectrum, 400-700 nm, SPECTRL2 sun and Harrison-Coombes sky from a date and place,
+7 m/s Cox-Munk sea, Case-1 water of chlorophyll 0.03 mg/m3 by the case1 component).
+
+Runs, interleaved, medians of `repeats` on 2 threads (compilation excluded): the scene without
+inelastic light (elastic), with Raman scattering and chlorophyll fluorescence at the defaults,
+and with other emission weights (estimator.emission_weight, the basis of the default). Per run:
+photons/s, the relative standard errors of Rrs nadir at 550 nm (whole, elastic part, Raman
+part) and 680 nm (fluorescence part), and each one's time to 1% (t (rel / 0.01)^2). The
+comparison the issue asks for: one history carrying both (the run with inelastic light gives
+the elastic and the inelastic parts at once) against the elastic run plus a separate run for
+the inelastic parts (whose time adds the elastic run's). Writes DIR/inelastic.md and
+DIR/inelastic.json (`oceanmc bench --inelastic`)."""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..run.simulation import simulate
+from .report import kernel_commit
+
+BATCHES = 64
+TARGET_REL = 0.01
+PROCESSES = {"raman": {}, "chlorophyll_fluorescence": {}}
+# (label, water.inelastic, estimator.emission_weight)
+RUNS = (("elastic only", None, None),
+        ("inelastic, defaults", PROCESSES, None),
+        ("inelastic, emission_weight 0.003", PROCESSES, 0.003),
+        ("inelastic, emission_weight 0.03", PROCESSES, 0.03))
+# (label, quantity, wavelength)
+ROWS = (("Rrs(550)", "air/Rrs_nadir", 550.0),
+        ("elastic Rrs(550)", "elastic/air/Rrs_nadir", 550.0),
+        ("Raman Rrs(550)", "raman/air/Rrs_nadir", 550.0),
+        ("fluorescence Rrs(680)", "chlorophyll_fluorescence/air/Rrs_nadir", 680.0))
+
+
+def scene(photons: int, seed: int, inelastic: dict | None, emission_weight: float | None
+          ) -> dict:
+    config = {
+        "name": "clear deep water, Chl 0.03", "photons": photons, "seed": seed,
+        "batches": BATCHES, "wavelengths_nm": {"start": 400.0, "stop": 700.0, "step": 10.0},
+        "illumination": {"sun_position": {"time": "2024-06-21T14:00:00Z", "latitude_deg": 31.7,
+                                          "longitude_deg": -64.2},
+                         "spectrum": {"model": "spectrl2"}, "sky": "harrison_coombes"},
+        "surface": {"model": "cox_munk", "wind_speed_m_s": 7.0},
+        "water": {"layers": [{"thickness_m": float("inf"), "components": [
+            {"model": "pure_water"}, {"model": "case1", "chl_mg_m3": 0.03}]}]},
+        "bottom": {"model": "none"},
+        "tallies": {"depths_m": [0.0]},
+    }
+    if inelastic is not None:
+        config["water"]["inelastic"] = inelastic
+    if emission_weight is not None:
+        config["estimator"] = {"emission_weight": emission_weight}
+    return config
+
+
+def _run(config: dict) -> tuple[float, dict]:
+    """(seconds, {row label: (value, relative standard error)})."""
+    t0 = time.perf_counter()
+    result = simulate(config, threads=2)
+    elapsed = time.perf_counter() - t0
+    grid = result.coords["wavelength"]
+    out = {}
+    for label, quantity, wavelength in ROWS:
+        if quantity in result:
+            k = int(np.argmin(np.abs(grid - wavelength)))
+            value = float(result[quantity][k])
+            out[label] = (value, float(result.stderr(quantity)[k]) / abs(value))
+    return elapsed, out
+
+
+def measure(quick: bool, say) -> dict:
+    photons = 10_000 if quick else 100_000
+    repeats = 1 if quick else 3
+    for _, inelastic, weight in RUNS:   # warm-up: compilation and the tables
+        simulate(scene(2 * BATCHES, 99, inelastic, weight), threads=2)
+    times = {label: [] for label, _, _ in RUNS}
+    errors: dict = {}
+    for r in range(repeats):
+        for label, inelastic, weight in RUNS:
+            say(f"  {label}, repeat {r + 1}")
+            elapsed, rows = _run(scene(photons, 1 + r, inelastic, weight))
+            times[label].append(elapsed)
+            errors.setdefault(label, rows)
+    runs = []
+    for label, _, _ in RUNS:
+        t = float(np.median(times[label]))
+        runs.append({"run": label, "time_s": t, "photons_per_s": photons / t,
+                     "rows": {row: {"value": v, "rel": e,
+                                    "time_to_target_s": t * (e / TARGET_REL) ** 2}
+                              for row, (v, e) in errors[label].items()}})
+    return {"photons": photons, "repeats": repeats, "runs": runs}
+
+
+def main(out_dir: Path, quick: bool) -> int:
+    data = measure(quick, lambda text: print(text, flush=True))
+    data["quick"] = quick
+    write(out_dir, data, kernel_commit())
+    print(f"wrote {out_dir / 'inelastic.md'}")
+    return 0
+
+
+def write(out_dir: Path, data: dict, commit: str) -> None:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "inelastic.json").write_text(json.dumps({**data, "kernel_commit": commit},
+                                                       indent=1))
+    runs = {run["run"]: run for run in data["runs"]}
+    elastic, default = runs["elastic only"], runs["inelastic, defaults"]
+    lines = ["# oceanmc benchmark: inelastic light (issue 27)", "",
+             "Regenerate with `oceanmc bench --inelastic -o benchmarks`"
+             + (" (--quick: small counts)" if data.get("quick") else "") + ". "
+             f"Kernel commit {commit}.", "",
+             "Clear deep water as users run it: 31 bands 400-700 nm, SPECTRL2 sun and "
+             "Harrison-Coombes sky (2024-06-21 14:00 UTC, 31.7 N 64.2 W), Cox-Munk sea at "
+             "7 m/s, pure water and case1 at Chl 0.03 mg/m3; Raman scattering and chlorophyll "
+             "fluorescence at their defaults (the grid is extended to 340 nm for the "
+             f"excitation). {data['photons']:,} photons per run, {BATCHES} batches, 2 threads, "
+             f"time the median of {data['repeats']} interleaved runs (compilation excluded); "
+             "time to 1% = t (relative standard error / 0.01)^2.", "",
+             "| run | photons/s | quantity | value | rel. std. error | time to 1% (s) |",
+             "|---|---|---|---|---|---|"]
+    for run in data["runs"]:
+        for row, e in run["rows"].items():
+            lines.append(f"| {run['run']} | {run['photons_per_s']:,.0f} | {row} | "
+                         f"{e['value']:.4g} | {100 * e['rel']:.2f}% | "
+                         f"{e['time_to_target_s']:,.1f} |")
+    cost = default["time_s"] / elastic["time_s"]
+    raman = default["rows"]["Raman Rrs(550)"]
+    own = elastic["rows"]["Rrs(550)"]["time_to_target_s"]
+    share = raman["value"] / default["rows"]["Rrs(550)"]["value"]
+    separate = (raman["time_to_target_s"] + own) / raman["time_to_target_s"]
+    lines += [
+        "", f"Cost of inelastic light at the defaults: {cost:.1f}x the elastic run's time for "
+        "the same photons.",
+        f"Raman part of Rrs(550) ({100 * share:.1f}% of the whole) to 1%: "
+        f"{raman['time_to_target_s']:,.1f} s against {own:,.1f} s for the elastic run's Rrs(550)"
+        f": {raman['time_to_target_s'] / own:.1f}x (target: at most 2x).",
+        f"One history against the elastic run plus a separate inelastic run: the separate "
+        f"way pays the elastic run's time on top, so the one history's figure of merit for "
+        f"the inelastic parts is {separate:.2f}x the separate way's; its elastic part "
+        f"reaches 1% in {default['rows']['elastic Rrs(550)']['time_to_target_s']:,.1f} s "
+        f"against the elastic run's {own:,.1f} s.", ""]
+    (out_dir / "inelastic.md").write_text("\n".join(lines))
