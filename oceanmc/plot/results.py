@@ -1,7 +1,8 @@
 """`oceanmc plot RESULT.h5`: the figures of a results file, as PNG.
 
 - the remote-sensing reflectance Rrs (air/Rrs_nadir) against wavelength with its standard-error
-  band (one marker for a monochromatic file);
+  band (one marker for a monochromatic file); with inelastic light also its parts (elastic,
+  Raman, fluorescence: elastic/air/Rrs_nadir, ...) with error bars, on a log axis;
 - Ed, Eu and Eo against depth, one line per selected wavelength, log irradiance axis, error bars
   of one standard error;
 - the radiance distribution at one depth and at 0+ (group air) on the polar quads, the downwelling
@@ -15,11 +16,12 @@ dimension of every spectral quantity; a monochromatic file has none, and both ar
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..run.results import PART_LABELS, lowest_requested
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
 # at most this many wavelengths share a profile panel (evenly spaced over the file's grid), so
@@ -37,6 +39,9 @@ class ResultFile:
     air: object            # xarray.Dataset of the group air (0+)
     path: Path
     derived: object = None  # xarray.Dataset of the group derived; None in a file without it
+    # xarray.Dataset of the group PART/air of each part of the light of a run with inelastic
+    # light (attribute inelastic_parts: elastic, raman, ...); empty without inelastic light
+    parts: dict = field(default_factory=dict)
 
     @property
     def wavelengths(self) -> np.ndarray | None:
@@ -72,7 +77,14 @@ def open_result(path: str | Path) -> ResultFile:
         derived = xr.load_dataset(path, engine="h5netcdf", group="derived")
     except (OSError, ValueError):   # written before oceanmc derived them, or no whole batch
         derived = None
-    return ResultFile(water, air, path, derived)
+    names = str(water.attrs.get("inelastic_parts", "")).split()
+    try:
+        parts = {name: xr.load_dataset(path, engine="h5netcdf", group=f"{name}/air")
+                 for name in names} if len(names) > 1 else {}
+    except (OSError, ValueError):
+        raise PlotInputError(f"{path}: its attribute inelastic_parts names parts "
+                             f"({', '.join(names)}) without their group PART/air") from None
+    return ResultFile(water, air, path, derived, parts)
 
 
 def _listed(values: np.ndarray, most: int = 12) -> str:
@@ -137,7 +149,8 @@ def _wavelength_label(result: ResultFile, index: int | None) -> str:
 
 def rrs_figure(result: ResultFile):
     """air/Rrs_nadir against wavelength, shaded +- one standard error; one marker with its error
-    bar for a monochromatic file. None where the file has no Rrs_nadir."""
+    bar for a monochromatic file. With inelastic light, its parts beside it (rrs_parts). None
+    where the file has no Rrs_nadir."""
     if "Rrs_nadir" not in result.air:
         return None
     rrs = result.air["Rrs_nadir"]
@@ -154,17 +167,61 @@ def rrs_figure(result: ResultFile):
     else:
         ax.fill_between(grid, value - se, value + se, color="C0", alpha=0.3,
                         label="+- 1 standard error")
-        ax.plot(grid, value, "o-", color="C0", ms=3, label="Rrs nadir")
+        ax.plot(grid, value, "o-", color="C0", ms=3,
+                label="Rrs nadir (whole)" if result.parts else "Rrs nadir")
         ax.set_xlabel("wavelength (nm)")
-    top = np.nanmax(value + np.nan_to_num(se))
-    ax.set_ylim(0.0, 1.3 * top if top > 0 else 1.0)
+    if result.parts and grid is not None:
+        rrs_parts(ax, result, value)
+    else:
+        top = np.nanmax(value + np.nan_to_num(se))
+        ax.set_ylim(0.0, 1.3 * top if top > 0 else 1.0)
     ax.set_ylabel(f"Rrs ({rrs.attrs.get('units', 'sr-1')})")
     name = result.water.attrs.get("name", result.path.name)
     # the axes' width (the figure's less the y axis labels): a long scene name is wrapped
     ax.set_title(fit_title(f"remote-sensing reflectance: {name}", size[0] - 0.9, 9), fontsize=9)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7 if result.parts else 8)
     return fig
+
+
+# the log axis of Rrs by part reaches at most this far below its largest value: in clear water
+# the Raman part in the red is some 3e-4 of the whole Rrs in the blue; smaller values (the
+# tails of the fluorescence band) fall below the axis
+RRS_PARTS_RANGE = 1e4
+
+
+def rrs_parts(ax, result: ResultFile, whole: np.ndarray) -> None:
+    """The parts of Rrs nadir of a run with inelastic light (PART/air/Rrs_nadir) on the Rrs
+    axes, beside the whole, each with error bars of one standard error, on a log axis (they
+    span decades); zeros are left out (Raman light at a wavelength whose excitation lies below
+    the traced grid, fluorescence away from its band). The wavelengths the run added below
+    those asked for, for the excitation, are shaded: their own inelastic light lacks what is
+    excited below the traced grid."""
+    grid = result.wavelengths
+    ax.set_yscale("log", nonpositive="clip")
+    drawn = [whole]
+    for k, (part, air) in enumerate(result.parts.items()):
+        if "Rrs_nadir" not in air:
+            continue
+        value = np.asarray(air["Rrs_nadir"])
+        err = np.asarray(air["Rrs_nadir_stderr"])
+        shown = value > 0
+        ax.errorbar(grid[shown], value[shown], yerr=err[shown], fmt="s-", ms=2.5, lw=1,
+                    capsize=2, color=f"C{k + 1}", label=f"{PART_LABELS.get(part, part)} part")
+        drawn.append(value)
+    positive = np.concatenate(drawn)
+    positive = positive[np.isfinite(positive) & (positive > 0)]
+    if positive.size:
+        top = float(positive.max())
+        ax.set_ylim(max(float(positive.min()), top / RRS_PARTS_RANGE) / 1.5, 2.0 * top)
+    added = np.atleast_1d(np.asarray(result.water.attrs.get("wavelengths_added_nm", []),
+                                     dtype=np.float64))
+    if added.size:
+        first = lowest_requested(grid, added)
+        below = added[added < first]
+        if below.size:
+            ax.axvspan(grid[0], 0.5 * (below.max() + first), color="0.6", alpha=0.15, lw=0,
+                       label="added for the excitation")
 
 
 PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward plane irradiance Eu"),

@@ -628,11 +628,137 @@ SUMMARY_WIDTH = 100
 SPECTRAL_BLOCK = (SUMMARY_WIDTH - 8) // 16
 
 
+def value_cell(value: float, err: float) -> str:
+    """A spectral table's cell of 15 characters: the value and its relative standard error in %
+    (0.0% for a value of 0)."""
+    rel = abs(err / value) if value != 0.0 else 0.0
+    return f"{value:>9.4g} {rel:>5.1%}"
+
+
+# the parts of the light (add_parts) as the summary's headings and the plots' legends name them
+PART_LABELS = {"elastic": "elastic", "raman": "Raman",
+               "chlorophyll_fluorescence": "fluorescence"}
+
+
+def light_parts(result: Result) -> list[str]:
+    """The parts of a run with inelastic light (attribute inelastic_parts: elastic, then each
+    process); [] without inelastic light."""
+    parts = str(result.attrs.get("inelastic_parts", "")).split()
+    return parts if len(parts) > 1 else []
+
+
+def lowest_requested(wavelengths: np.ndarray, added: np.ndarray) -> float:
+    """The lowest wavelength (nm) the scene asked for, of a grid that also holds the wavelengths
+    a run added for the excitation of inelastic light."""
+    return float(min(w for w in wavelengths if not np.isclose(added, w).any()))
+
+
+def wavelength_ranges(wavelengths: np.ndarray) -> str:
+    """Sorted wavelengths in few words: runs of three or more at one step as '340-390 nm
+    (10 nm steps)', the others one by one ('405 nm')."""
+    pieces = []
+    start = 0
+    while start < len(wavelengths):
+        end = start + 1   # the run is wavelengths[start:end]
+        step = wavelengths[end] - wavelengths[start] if end < len(wavelengths) else 0.0
+        while end < len(wavelengths) and np.isclose(wavelengths[end] - wavelengths[end - 1],
+                                                    step):
+            end += 1
+        if end - start >= 3:
+            pieces.append(f"{wavelengths[start]:g}-{wavelengths[end - 1]:g} nm ({step:g} nm "
+                          "steps)")
+        else:   # two at one step: the first alone, the second may begin a run
+            end = start + 1
+            pieces.append(f"{wavelengths[start]:g} nm")
+        start = end
+    return ", ".join(pieces)
+
+
+def process_descriptions(result: Result) -> list[str]:
+    """Each inelastic process of a run with its settings, as the stored scene has them (with
+    the defaults filled in), so that a comparison (e.g. with HydroLight) can check them; the
+    parts' names alone where the stored scene cannot be read."""
+    import yaml
+
+    from ..config.inelastic import Inelastic
+    try:
+        inelastic = Inelastic(**yaml.safe_load(result.config_yaml)["water"]["inelastic"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return [PART_LABELS.get(part, part) for part in light_parts(result)[1:]]
+    said = []
+    for name, process in inelastic.processes():
+        if name == "raman":
+            said.append(f"Raman scattering by water (b_R {process.b488_per_m:g} 1/m at 488 nm, "
+                        f"as (488/l)^{process.exponent:g})")
+        elif name == "chlorophyll_fluorescence":
+            low, high = process.excitation_range_nm
+            said.append(f"chlorophyll fluorescence (quantum yield {process.quantum_yield:g}, "
+                        f"{process.peak_nm:g} nm, sigma {process.sigma_nm:g} nm, excited "
+                        f"{low:g}-{high:g} nm)")
+        else:
+            said.append(PART_LABELS.get(name, name))
+    return said
+
+
+def inelastic_lines(result: Result) -> list[str]:
+    """For a run with inelastic light: the processes that were on, the parts every quantity is
+    split into, and the wavelengths traced beyond those asked for (attribute
+    wavelengths_added_nm), whose own inelastic light lacks what would be excited below the
+    traced grid (Raman light at 370 nm comes from 323-335 nm). [] without inelastic light."""
+    parts = light_parts(result)
+    if not parts:
+        return []
+    said = [f"inelastic light: {', '.join(process_descriptions(result))}; every quantity but "
+            "the ratios is also split into parts that add up to it: "
+            f"{', '.join(p + '/' for p in parts)} (e.g. {parts[1]}/air/Rrs_nadir)"]
+    if "wavelengths_added_nm" in result.attrs:
+        added = np.atleast_1d(np.asarray(result.attrs["wavelengths_added_nm"], dtype=float))
+        wavelengths = result.coords["wavelength"]
+        if len(added) == 0:
+            said.append("traced no wavelength beyond those asked for: they hold the excitation "
+                        "of the inelastic light")
+        else:
+            first = lowest_requested(wavelengths, added)
+            below = f", though those below {first:g} nm lack the inelastic light excited " \
+                f"below {wavelengths[0]:g} nm" if (added < first).any() else ""
+            said.append(f"traced also {wavelength_ranges(np.sort(added))} for the excitation "
+                        f"of inelastic light; reported with the rest{below}")
+    return [line for text in said
+            for line in textwrap.wrap(text, SUMMARY_WIDTH, initial_indent="  ",
+                                      subsequent_indent="    ")]
+
+
+def rrs_parts_table(result: Result) -> list[str]:
+    """For a run with inelastic light: Rrs nadir of each part of the light per wavelength, its
+    relative standard error and its share of the whole Rrs nadir; [] without inelastic light or
+    without Rrs nadir. The elastic part and both processes fit SUMMARY_WIDTH (77 characters)."""
+    parts = [part for part in light_parts(result) if f"{part}/air/Rrs_nadir" in result]
+    if not parts or "air/Rrs_nadir" not in result:
+        return []
+    whole = result["air/Rrs_nadir"]
+    head = ("Rrs nadir by part of the light: value, relative standard error and share of the "
+            f"whole ({', '.join(f'{p}/air/Rrs_nadir' for p in parts)})")
+    lines = [""] + textwrap.wrap(head, SUMMARY_WIDTH, initial_indent="  ",
+                                 subsequent_indent="  ")
+    lines.append(f"  {'nm':>6}" + "".join(f" {PART_LABELS.get(p, p):>15} {'share':>6}"
+                                          for p in parts))
+    for k, wavelength in enumerate(result.coords["wavelength"]):
+        row = f"  {wavelength:>6g}"
+        for part in parts:
+            value = result[f"{part}/air/Rrs_nadir"][k]
+            share = value / whole[k] if whole[k] != 0.0 else 0.0
+            row += f" {value_cell(value, result.stderr(f'{part}/air/Rrs_nadir')[k]):>15}" \
+                f" {share:>6.1%}"
+        lines.append(row)
+    return lines
+
+
 def format_spectrum(result: Result) -> list[str]:
     """A spectral run as a table: one row per wavelength, the headline quantities in columns
     (z1: the first tally depth), each value with its relative standard error in %, in blocks of
-    columns no wider than SUMMARY_WIDTH; then what the Rrs columns are (their estimators) and
-    where the light came from."""
+    columns no wider than SUMMARY_WIDTH, and with inelastic light Rrs nadir by part of the light;
+    then what the Rrs columns are (their estimators), the inelastic processes and the wavelengths
+    added for them, and where the light came from."""
     depths = result.coords["depth"]
     first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
     columns = []
@@ -649,8 +775,7 @@ def format_spectrum(result: Result) -> list[str]:
             value, err = result[name][k], result.stderr(name)[k]
             if index is not None:
                 value, err = value[index], err[index]
-            rel = abs(err / value) if value != 0.0 else 0.0
-            column.append(f"{value:>9.4g} {rel:>5.1%}")
+            column.append(value_cell(value, err))
         cells.append(column)
     # the table is printed in blocks of at most SPECTRAL_BLOCK columns, each after the nm
     # column, so that a line fits a terminal of SUMMARY_WIDTH characters: the quantities at
@@ -667,7 +792,9 @@ def format_spectrum(result: Result) -> list[str]:
         lines.append(f"  {'nm':>6}" + "".join(f" {columns[c][0]:>15}" for c in block))
         lines += [f"  {wavelength:>6g}" + "".join(f" {cells[c][k]:>15}" for c in block)
                   for k, wavelength in enumerate(result.coords["wavelength"])]
+    lines += rrs_parts_table(result)
     lines += estimator_lines(result)
+    lines += inelastic_lines(result)
     lines += illumination_lines(result)
     lines.append("  (value and relative standard error; irradiances in the units of Ed(0+), "
                  "Rrs in 1/sr,")
