@@ -19,8 +19,9 @@ from .base import _Strict
 
 Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 
-# Walrafen's four Gaussians reach below 1e-6 of their peak outside these wavenumber shifts
-# (1/cm; centres 3250-3625, widths 140-210 FWHM: the outer ones +-5 standard deviations)
+# outside these wavenumber shifts (1/cm; centres 3250-3625, widths 140-210 FWHM: the outer
+# lines at +-5 standard deviations) Walrafen's four Gaussians hold less than 1e-6 of the light
+# and fall to 2e-6 of their peak
 RAMAN_SHIFT_RANGE = (2800.0, 3950.0)
 
 
