@@ -6,7 +6,7 @@ E_i = sum_j x_j T_ji (T the process's transfer: redistribution, photon-to-energy
 lambda_j / lambda_i, and the source spectrum's ratio Ed0_j / Ed0_i, since a packet's weight at
 a wavelength is a share of that wavelength's Ed0). The emission starts a packet of its own at
 the collision point (a new source of light, as the sun's photons are: hero wavelength drawn
-anew, K = 1), in a direction drawn from the process's phase function about the incident
+anew, in proportion to the emission), in a direction drawn from the process's phase function about the incident
 direction, tallied in the process's part of the tally row (p.part); it waits on the split stack
 and is traced after the packet that emitted it, within the same photon history. The emitting
 packet goes on elastically: the process's loss is in its attenuation (Raman) or absorption
@@ -24,6 +24,8 @@ geometrically). The transfer is banded (channel_band), so the emission costs the
 per excitation wavelength, not n. Its draws come from the batch's second stream (rng_emitted), so that the elastic
 light's draws, and with them the elastic part of every output, are those of the same scene
 without the inelastic processes (whose loss is kept as absorption)."""
+import math
+
 from .. import local_estimate, packet
 from ..compile import internal
 from ..geometry import turn
@@ -113,11 +115,22 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     child = stack[n_stacked]
     child_ps = stack_ps[n_stacked]
     k_view, g, last = packet.weights(grid, child_ps)
-    per_emitted = 1.0 / (total * scale)
+    # its hero wavelength drawn in proportion to what it carries (pi_i = E_i / sum E), not
+    # uniformly: the one-sample MIS weight becomes f_l / sum_j pi_j p_j, which the spectral
+    # state holds with K_j = n pi_j at the start (mean K = 1; spectral.py), so a red emission
+    # is not walked by an ultraviolet hero whose long free paths it does not survive
+    emitted = total * scale
+    per_emitted = 1.0 / emitted
+    pick = uniform(rng_emitted) * emitted
+    hero = heaviest
     for i in range(n):
-        k_view[i] = 1.0
+        k_view[i] = n * emission[i] * per_emitted
         last[i] = emission[i]
         g[i] = emission[i] * per_emitted
+        pick -= emission[i]
+        if pick < 0.0 and emission[i] > 0.0:
+            hero = i
+            pick = math.inf
     child_ps[packet.free_path_at(grid)] = 0.0
     cos_t = quadratic.sample(floats[medium.channel_beta + channel:], uniform(rng_emitted))
     child.ux, child.uy, child.uz = turn(p.ux, p.uy, p.uz, cos_t, uniform(rng_emitted))
@@ -126,6 +139,6 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     child.w = total * scale
     child.beam = 0
     child.part = part
-    child.wavelength = min(n - 1, int(uniform(rng_emitted) * n))
+    child.wavelength = hero
     child.reference = heaviest
     return n_stacked + 1

@@ -96,8 +96,14 @@ def compare_thin_layer(ctx: Ctx) -> None:
         result = ctx.simulate(thin_layer(f"thin layer, {label}", photons, b488))
         k = at(result, EMISSION)
         if b488 == BOOSTED_B488:
+            # the walk's light spans the kernel's traced grid, as the run's does: at 100 x b_R
+            # the second and third Raman orders matter, and light below the grid (which the
+            # run does not trace: the grid is extended for the first order only) would add
+            # to them
+            grid = result.coords["wavelength"]
             walk = raman_reference.reference_walk(
-                EMISSION, DEPTH, absorption, b488=b488, excitation_range_nm=(300.0, 560.0),
+                EMISSION, DEPTH, absorption, b488=b488,
+                excitation_range_nm=(float(grid[0]), float(grid[-1])),
                 photons=ctx.pick(20_000_000, 4_000_000), seed=ctx.next_seed(), bin_nm=2.0,
                 mu_cut=mu_cut)
             references = {name: walk[name] for name in ("Eu_top", "Ed_bottom", "Eou_top")}
