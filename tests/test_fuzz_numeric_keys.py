@@ -127,7 +127,7 @@ def templates(folder):
                       bottom={"model": "none"}, tallies=SMALL_TALLIES),
         "specular": _mono(bottom={"model": "specular", "reflectance": 0.5},
                           tallies=SMALL_TALLIES),
-        # the grid is extended for the excitation (config/inelastic.py): 370-700 nm traced
+        # the grid is extended for the excitation (config/inelastic.py): 520-700 nm traced
         "inelastic": _mono(
             wavelengths_nm={"start": 660, "stop": 700, "step": 20}, tallies=SMALL_TALLIES,
             water={"layers": [{"thickness_m": 2.0, "components": [
@@ -136,7 +136,7 @@ def templates(folder):
                                         "phase_beta": 0.55},
                               "chlorophyll_fluorescence": {
                                   "quantum_yield": 0.02, "peak_nm": 685, "sigma_nm": 10.6,
-                                  "excitation_range_nm": [370, 690]},
+                                  "excitation_range_nm": [600, 690]},
                               "max_step_nm": 10}},
             estimator={"emission_weight": 0.01}),
         "bottom_mixture_spectra": _mono(

@@ -66,6 +66,10 @@ def transfer(process, settings, wavelengths_nm: np.ndarray, sigma_shape: np.ndar
     shape sigma_shape (n_wl; its layers' coefficients are multiples of it, or the shape is
     what matters between traced wavelengths: it is interpolated like the weights)."""
     wl = np.asarray(wavelengths_nm, dtype=np.float64)
+    # only the shape matters: scaled to a largest value of 1, so that a tiny coefficient
+    # (1e-308) neither underflows in the integral nor overflows in its inverse
+    top = float(np.max(sigma_shape, initial=0.0))
+    sigma_shape = sigma_shape / top if top > 0.0 else sigma_shape
     count = int(np.ceil((wl[-1] - wl[0]) / FINE_STEP_NM)) + 1
     fine = np.linspace(wl[0], wl[-1], count)
     step = fine[1] - fine[0] if count > 1 else 0.0
