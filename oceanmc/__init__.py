@@ -19,7 +19,7 @@ _LAZY = {
     "ConfigError": "config",
     "SceneConfig": "config",
     "load_config": "config",
-    "Result": "run.results",
+    "Result": "run.result",
     "load_result": "run.hdf5",
     "simulate": "run.simulation",
     "sweep": "sweeps",
@@ -33,7 +33,7 @@ __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result",
 if TYPE_CHECKING:
     from .config import ConfigError, SceneConfig, load_config
     from .run.hdf5 import load_result
-    from .run.results import Result
+    from .run.result import Result
     from .run.simulation import simulate
     from .sweeps import sweep
 

@@ -93,13 +93,12 @@ class StopRequest:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .config import ConfigError, config_to_yaml, data_file_hashes, load_config
-    from .run.hdf5 import load_result
-    from .run.results import (MergeError, check_resumable, check_same_data_files,
-                              format_summary, merge_results, scene_difference)
+    from .config import ConfigError, load_config
     from .run.compiling import CompileInterrupted
-    from .run.simulation import NonFiniteResult, check_tally_memory, simulate
-    from . import scene
+    from .run.merge import MergeError
+    from .run.resume import CannotResume, RunFile, partial_run
+    from .run.simulation import NonFiniteResult, prepare, simulate
+    from .run.summary import format_summary
 
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
@@ -110,77 +109,37 @@ def cmd_run(args: argparse.Namespace) -> int:
     scenes = []
     for path, out in zip(configs, outputs):
         try:
-            config = load_config(path, overrides)
             # reads its data files: every scene is checked before any runs
-            check_tally_memory(config, scene.build(config))
+            run = prepare(load_config(path, overrides))
         except ConfigError as exc:
             print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
                   else f"oceanmc: config error: {exc}", file=sys.stderr)
             return 2
         _check_writable(out, args.overwrite or (args.resume and out.exists()),
-                        _file_size_estimate(config))
+                        _file_size_estimate(run.config))
         previous = None
         if args.resume and out.exists():
             try:
-                previous = load_result(out)
-            except ValueError as exc:  # ResultsFileError: one line saying what is wrong
-                raise UsageError(f"--resume: {out}: {exc}") from None
-            if not previous.attrs.get("partial", False):
-                raise UsageError(f"--resume: {out} is already complete "
-                                 f"({previous.attrs['batches']} batches)")
-            try:
-                check_resumable(previous)
-            except MergeError as exc:
-                raise UsageError(f"--resume: {out}: {exc}") from None
-            done = int(previous.attrs["first_batch"]) + int(previous.attrs["batches"])
-            if done >= config.batches:
-                raise UsageError(f"--resume: {out} is marked partial but holds batches up to "
-                                 f"{done - 1} of {path}'s {config.batches}: nothing to continue")
-            differs = scene_difference(previous.config_yaml, config_to_yaml(config))
-            if differs:
-                raise UsageError(f"--resume: {out} was made from a different scene than {path} "
-                                 f"({differs}; compare with `oceanmc show --config`)")
-            try:
-                check_same_data_files(previous.attrs, {"data_files_sha256":
-                                                       data_file_hashes(config)}, str(path))
-            except MergeError as exc:
+                previous = partial_run(out, run, path)
+            except CannotResume as exc:
                 raise UsageError(f"--resume: {exc}") from None
-        scenes.append((path, out, config, previous))
+        scenes.append((path, run, RunFile(out, previous, args.overwrite)))
 
     stop = StopRequest()
     stop.install()
-    for path, out, config, previous in scenes:
-        first, resume_state = 0, None
-        if previous is not None:
-            first = int(previous.attrs.get("first_batch", 0)) + int(previous.attrs["batches"])
-            resume_state = previous.resume_state
-
-        def combined(result, previous=previous):
-            return result if previous is None else merge_results([previous, result], resume=True)
-
-        # the first placement refuses to replace a file another run made meanwhile; the
-        # checkpoints that follow replace this run's own file
-        replace = {"ok": args.overwrite or previous is not None, "written": False}
-
-        def checkpoint(partial, out=out, combined=combined, replace=replace):
-            combined(partial).save(out, overwrite=replace["ok"])
-            replace["ok"] = replace["written"] = True
+    for path, run, output in scenes:
         try:
-            result = simulate(config, threads=args.threads, progress=not args.quiet,
-                              first_batch=first, should_stop=lambda: stop.requested,
-                              on_checkpoint=checkpoint, checkpoint_every_s=args.checkpoint_every,
-                              resume_state=resume_state)
-            result = combined(result)
-        except ConfigError as exc:  # auxiliary tables are read when the scene is built
-            print(f"oceanmc: config error: {path}: {exc}", file=sys.stderr)
-            return 2
+            result = output.combined(simulate(
+                run, threads=args.threads, progress=not args.quiet,
+                first_batch=output.first_batch, should_stop=lambda: stop.requested,
+                on_checkpoint=output.checkpoint, checkpoint_every_s=args.checkpoint_every,
+                resume_state=output.resume_state))
         except MergeError as exc:
             raise UsageError(f"--resume: {exc}") from None
         except NonFiniteResult as exc:
             # a file this run's checkpoints made before the fault showed is not left as if the
-            # scene had run well; a resumed file keeps its last (finite) checkpoint
-            if replace["written"] and previous is None:
-                out.unlink(missing_ok=True)
+            # scene had run well
+            output.discard()
             print(f"oceanmc: error: {path}: {exc}", file=sys.stderr)
             return 3
         except CompileInterrupted:
@@ -190,15 +149,15 @@ def cmd_run(args: argparse.Namespace) -> int:
             sys.stdout.flush()
             os._exit(130)
         result.attrs["config_file"] = str(path)
-        result.save(out, overwrite=replace["ok"])
+        output.save(result)
         print(format_summary(result))
-        print(f"  wrote {out}")
+        print(f"  wrote {output.path}")
         if result.attrs.get("partial"):   # the summary's PARTIAL line says how much is whole
             unfinished = result.resume_state
             n = 0 if unfinished is None else len(unfinished["batch"])
             begun = f"{n} more batch{'es' if n > 1 else ''} begun, kept to be continued; " \
                 if n else ""
-            print(f"  {begun}continue with: oceanmc run {path} -o {out} --resume"
+            print(f"  {begun}continue with: oceanmc run {path} -o {output.path} --resume"
                   + "".join(f" --{key} {value}" for key, value in overrides.items()
                             if value is not None))
         print()
@@ -210,7 +169,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_merge(args: argparse.Namespace) -> int:
     from .run.hdf5 import load_result
-    from .run.results import MergeError, format_summary, merge_results
+    from .run.merge import MergeError, merge_results
+    from .run.summary import format_summary
 
     out = Path(args.output)
     parts = []
@@ -236,7 +196,7 @@ def cmd_merge(args: argparse.Namespace) -> int:
 def cmd_show(args: argparse.Namespace) -> int:
     from .run.derived import format_derived
     from .run.hdf5 import load_result
-    from .run.results import format_summary
+    from .run.summary import format_summary
 
     path = Path(args.file)
     if not path.is_file():
@@ -526,7 +486,7 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
     except OSError as exc:
-        if not hasattr(exc, "kept"):  # run.hdf5.ResultsSavedElsewhere, without importing h5py
+        if not hasattr(exc, "kept"):  # run.placement.ResultsSavedElsewhere
             raise
         print(f"oceanmc: error: {exc}", file=sys.stderr)
         return 1 if "no space" in exc.reason else 2

@@ -12,7 +12,7 @@ import yaml
 import oceanmc
 from oceanmc.cli import main
 from oceanmc.kernel.models import FLUX_EOD
-from oceanmc.run import simulation
+from oceanmc.run import derivation, simulation
 from oceanmc.run.results import Result
 from oceanmc.run.simulation import NonFiniteResult
 
@@ -26,7 +26,7 @@ def poison(monkeypatch, value=math.nan, wavelength=None, when=lambda batches: Tr
     """from_tallies with `value` in one batch of the flux tallies (Eod at the first depth, so
     Eod and Eo = Eod + Eou) of
     the given wavelength (index; None: every one), when `when(whole batches)` holds."""
-    real = simulation.from_tallies
+    real = derivation.from_tallies
     seen = {"k": -1}
 
     def from_tallies(raw, *args, **kwargs):
@@ -36,7 +36,7 @@ def poison(monkeypatch, value=math.nan, wavelength=None, when=lambda batches: Tr
                 wavelength in (None, seen["k"] % len(SPECTRAL["wavelengths_nm"])):
             raw["flux"][0, 0, FLUX_EOD] = value
         return real(raw, *args, **kwargs)
-    monkeypatch.setattr(simulation, "from_tallies", from_tallies)
+    monkeypatch.setattr(derivation, "from_tallies", from_tallies)
 
 
 def test_a_nan_in_one_wavelengths_tallies_is_refused_naming_quantity_and_wavelength(

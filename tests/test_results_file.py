@@ -121,7 +121,7 @@ def test_failed_write_leaves_no_file(result, tmp_path, monkeypatch):
 
     def explode(*args, **kwargs):
         raise RuntimeError("disk full")
-    monkeypatch.setattr("oceanmc.run.hdf5._write", explode)
+    monkeypatch.setattr("oceanmc.run.format._write", explode)
     with pytest.raises(RuntimeError):
         save_result(result, target)
     assert list(tmp_path.iterdir()) == []

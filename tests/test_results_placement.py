@@ -9,8 +9,8 @@ import threading
 import numpy as np
 import pytest
 
-from oceanmc.run import hdf5
-from oceanmc.run.hdf5 import ResultsSavedElsewhere, place_atomically
+from oceanmc.run import placement
+from oceanmc.run.placement import ResultsSavedElsewhere, place_atomically
 
 
 def _writer(value):
@@ -74,14 +74,14 @@ def test_disk_full_keeps_results_in_temp_dir(tmp_path, monkeypatch):
     target = tmp_path / "full" / "out.h5"
     spare = tmp_path / "spare"
     spare.mkdir()
-    monkeypatch.setattr(hdf5.tempfile, "gettempdir", lambda: str(spare))
-    real = hdf5._write_temp
+    monkeypatch.setattr(placement.tempfile, "gettempdir", lambda: str(spare))
+    real = placement._write_temp
 
     def failing(tmp, write):
         if tmp.parent == target.parent:
             raise OSError(errno.ENOSPC, "No space left on device")
         real(tmp, write)
-    monkeypatch.setattr(hdf5, "_write_temp", failing)
+    monkeypatch.setattr(placement, "_write_temp", failing)
     with pytest.raises(ResultsSavedElsewhere) as info:
         place_atomically(target, _writer(5.0))
     assert info.value.kept.parent == spare

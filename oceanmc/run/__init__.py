@@ -1,2 +1,6 @@
-"""The run: simulation.py traces a packed scene on the compiled kernel (compiling.py compiles
-or loads it), results.py turns the batch tallies into a Result, hdf5.py writes and reads it."""
+"""The run, following the data: simulation.py packs a scene (prepare) and traces its batches on
+the compiled kernel (compiling.py compiles or loads it); derivation.py turns the batch tallies
+into a Result (result.py: the model), derived.py the apparent optical properties of one;
+merge.py combines runs, resume.py continues a partial one (`oceanmc run --resume`);
+format.py writes a Result into its HDF5 file, placed atomically (placement.py), hdf5.py reads it
+back; summary.py prints it. results.py gathers the names users import."""

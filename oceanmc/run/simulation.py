@@ -1,5 +1,5 @@
-"""simulate(config) -> Result: packs the scene (scene/), traces the batches on the compiled
-kernel in a thread pool, and hands the tallies to results.py.
+"""simulate(config) -> Result: packs the scene (prepare: scene/), traces the batches on the
+compiled kernel in a thread pool, and hands the tallies to derivation.py.
 
 A batch is traced in short calls (transport.trace_batch continues a batch where the last call
 stopped, bit for bit), each given a work budget that keeps it near CALL_SECONDS, so a stop, a
@@ -10,12 +10,12 @@ stream, next photon, entered sun beam, the tallies so far as named arrays) in
 Result.resume_state, from which a resumed run continues them exactly."""
 from __future__ import annotations
 
-import math
 import os
 import sys
 import threading
 import time
 from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
@@ -26,13 +26,13 @@ from tqdm import tqdm
 from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
-from ..kernel.models import BUDGET_LAYERS
 from ..kernel.records import PACKET, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
 from .compiling import ready
-from .results import (MergeError, Result, add_parts, from_tallies, stack_wavelengths,
-                      sun_of)
+from .derivation import RunFacts, run_result
+from .merge import MergeError
+from .result import Result
 
 
 LINE_FLOATS = 8                           # a 64-byte cache line of float64
@@ -48,8 +48,8 @@ LONG_RUN_S = 3600.0     # a run estimated longer than this says so at its start
 
 
 # the tallies may take this share of the machine's physical memory, counting the RESULT_COPIES
-# of them a run holds at its end (the rows, their normalised copy in from_tallies, the
-# temporaries of the means and standard errors written to the file)
+# of them a run holds at its end (the rows, their normalised copy in derivation.from_tallies,
+# the temporaries of the means and standard errors written to the file)
 MEMORY_SHARE = 0.5
 RESULT_COPIES = 3
 
@@ -119,24 +119,184 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h" if seconds < 48 * 3600 else f"{seconds / 86400:.1f} days"
 
 
-def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int) -> np.ndarray:
-    """The budget with the absorption of the sublayers of a depth profile summed into the
-    configured layer they resolve."""
-    if len(config_layer) == n_layers:
-        return budget
-    out = np.zeros(budget.shape[:-1] + (BUDGET_LAYERS + n_layers,))
-    out[..., :BUDGET_LAYERS] = budget[..., :BUDGET_LAYERS]
-    np.add.at(out.T, BUDGET_LAYERS + config_layer, budget[..., BUDGET_LAYERS:].T)
-    return out
+@dataclass(frozen=True)
+class PreparedRun:
+    """A scene ready to trace, made once per run by prepare(): `oceanmc run` checks every scene
+    this way before the first runs, then hands each to simulate as it is."""
+    config: SceneConfig
+    scene: scene.Scene
+    facts: RunFacts     # fixed for the run: the derivation's, and the illumination spectrum
+    scene_yaml: str     # the resolved scene as stored (with a spectrum's Ed(0+) noted)
+    data_hashes: str    # data_files_sha256: the data files the scene names, as the build read
 
 
-def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int | None = None,
-             progress: bool = False, first_batch: int = 0,
+def prepare(config: SceneConfig) -> PreparedRun:
+    """Packs a validated scene and computes its illumination spectrum, once. Raises
+    ConfigError (one line) for unusable auxiliary files or tallies too large for memory."""
+    data_hashes = data_file_hashes(config)   # before the build reads them
+    sc = scene.build(config)
+    check_tally_memory(config, sc)
+    ed0, diffuse, _ = illumination_spectrum(config)
+    return PreparedRun(config, sc, RunFacts.of(config, sc, ed0, diffuse),
+                       config_to_yaml(config, (ed0, diffuse)), data_hashes)
+
+
+class Batches:
+    """The state of batches first .. config.batches-1 between kernel calls, each batch's on
+    cache lines of its own: random streams (the photons', then the inelastic emissions'), next
+    photon (-1: not begun), entered sun beam (weight per sun packet, direction), scattering
+    events, tally row, packet, the stack its split copies and emitted packets wait on, their
+    spectral state (kernel/packet.py) and one event's scratch. A batch's lock is held through
+    each of its calls, so that a snapshot copies its state between two calls."""
+
+    def __init__(self, run: PreparedRun, first: int) -> None:
+        config, sc = run.config, run.scene
+        self.first, self.grid = first, sc.grid
+        self.photons_per_batch = run.facts.photons_per_batch
+        n = config.batches - first
+        self.rngs = np.zeros((n, RNG_STRIDE), dtype=np.uint64)
+        for b in range(n):
+            self.rngs[b, :STATE_WORDS] = batch_state(config.seed, first + b)
+            self.rngs[b, STATE_WORDS:RNG_WORDS] = batch_state(config.seed, first + b, 1)
+        self.beams = np.zeros((n, 4))
+        self.beams[:, 3] = 1.0
+        self.next_photon = np.full(n, -1, dtype=np.int64)
+        self.events = np.zeros(n, dtype=np.int64)
+        self.tallies = np.zeros((n, row_floats(sc.tally_size)))
+        self.packets = np.zeros((n, PACKET_STRIDE), dtype=PACKET)
+        self.stacks = np.zeros((n, sc.stack_rows), dtype=PACKET)
+        n_wl = len(config.wavelengths)
+        self.states = np.zeros((n, sc.stack_rows + 1, row_floats(packet_state_size(n_wl))))
+        self.work = np.zeros((n, row_floats(work_size(n_wl))))
+        self.locks = [threading.Lock() for _ in range(n)]
+        self.stopping = threading.Event()
+
+    def __len__(self) -> int:
+        return len(self.next_photon)
+
+    def trace(self, b: int, trace: Callable, args: tuple) -> None:
+        """Traces batch b to its end in calls of about CALL_SECONDS, or until stopping."""
+        budget = FIRST_BUDGET
+        while not self.stopping.is_set():
+            with self.locks[b]:
+                if self.next_photon[b] >= self.photons_per_batch:
+                    return
+                t = time.perf_counter()
+                self.next_photon[b], n_events = trace(
+                    *args, self.photons_per_batch, self.next_photon[b], budget,
+                    self.rngs[b, :STATE_WORDS], self.rngs[b, STATE_WORDS:RNG_WORDS],
+                    self.beams[b], self.tallies[b], self.packets[b, :1], self.stacks[b],
+                    self.states[b], self.work[b])
+                self.events[b] += n_events
+            budget = next_budget(budget, time.perf_counter() - t)
+
+    def photons(self) -> int:
+        """Photons traced so far."""
+        return int(np.maximum(self.next_photon, 0).sum())
+
+    def whole(self) -> int:
+        """How many leading batches are whole."""
+        done = 0
+        while done < len(self) and self.next_photon[done] >= self.photons_per_batch:
+            done += 1
+        return done
+
+    def unfinished(self, done: int) -> dict[str, np.ndarray] | None:
+        """The state of the batches begun after the `done` leading whole ones (a Result's
+        resume_state), None if none is. The tallies as named arrays (tally/flux, ...), not raw
+        rows: the row's layout is the kernel's to change, a file's state stays readable."""
+        begun = [b for b in range(done, len(self)) if self.next_photon[b] >= 0]
+        if not begun:
+            return None
+        scores = tally_arrays(self.grid, self.tallies)
+        state = {"batch": np.array(begun, dtype=np.int64) + self.first,
+                 "rng": np.empty((len(begun), RNG_WORDS), dtype=np.uint64),
+                 "beam": np.empty((len(begun), 4)),
+                 "next_photon": np.empty(len(begun), dtype=np.int64),
+                 "events": np.empty(len(begun), dtype=np.int64)}
+        state.update({f"tally/{name}": np.empty((len(begun),) + values.shape[1:])
+                      for name, values in scores.items()})
+        for k, b in enumerate(begun):
+            with self.locks[b]:
+                state["rng"][k] = self.rngs[b, :RNG_WORDS]
+                state["beam"][k] = self.beams[b]
+                state["next_photon"][k] = self.next_photon[b]
+                state["events"][k] = self.events[b]
+                for name, values in scores.items():
+                    state[f"tally/{name}"][k] = values[b]
+        return state
+
+    def restore(self, state: dict[str, np.ndarray]) -> None:
+        """Puts a partial run's unfinished batches (Result.resume_state) back where they
+        stopped, their tally rows rebuilt from the named score arrays. Raises MergeError (one
+        line: the CLI's --resume says it and exits 2) when those arrays or batches are not this
+        scene's."""
+        rows = np.zeros((len(state["batch"]), self.tallies.shape[1]))
+        try:
+            write_tally_arrays(self.grid, {key.removeprefix("tally/"): values
+                                           for key, values in state.items()
+                                           if key.startswith("tally/")}, rows)
+        except ValueError as exc:
+            raise MergeError(f"the stored unfinished batches' tallies do not fit this scene: "
+                             f"{exc}") from None
+        for k, batch in enumerate(state["batch"]):
+            b = int(batch) - self.first
+            if not 0 <= b < len(self):
+                raise MergeError(f"stored unfinished batch {batch} is outside {self.first} .. "
+                                 f"{self.first + len(self) - 1}")
+            # (a file from before the second stream holds the first only: the second starts
+            # anew)
+            self.rngs[b, :state["rng"].shape[1]] = state["rng"][k]
+            self.beams[b] = state["beam"][k]
+            self.next_photon[b] = state["next_photon"][k]
+            self.events[b] = state["events"][k]
+            self.tallies[b] = rows[k]
+
+
+def run_attrs(run: PreparedRun, batches: Batches, done: int, threads: int, wall: float,
+              startup: float) -> dict[str, object]:
+    """The attributes of a Result of the `done` leading whole batches, traced in `wall`
+    seconds after a start-up (the kernel compiled or loaded) of `startup` seconds."""
+    config, facts = run.config, run.facts
+    photons = done * facts.photons_per_batch
+    attrs = {
+        "name": config.name,
+        "config_yaml": run.scene_yaml,
+        "data_files_sha256": run.data_hashes,
+        "oceanmc_version": __version__,
+        "numba_version": numba.__version__,
+        "seed": config.seed,
+        "photons": photons,
+        "batches": done,
+        "first_batch": batches.first,
+        "photons_per_batch": facts.photons_per_batch,
+        "partial": batches.first + done < config.batches,
+        "threads": threads,
+        "wall_time_s": wall,
+        "startup_time_s": startup,
+        "photons_per_s": photons / wall if wall > 0 else float("inf"),
+        "scattering_events": int(batches.events[:done].sum()),
+        # Ed(0+) and its diffuse (sky) share per wavelength, as the run used them (from
+        # illumination's Ed0 and diffuse_fraction, or its spectrum model or table)
+        "illumination_Ed0": np.asarray(facts.ed0, dtype=np.float64),
+        "illumination_diffuse_fraction": np.asarray(facts.diffuse, dtype=np.float64),
+    }
+    if facts.inelastic:
+        # the outputs' parts (derivation.add_parts), and the wavelengths traced for the
+        # excitation of inelastic light beyond those asked for (config/inelastic.py)
+        attrs["inelastic_parts"] = " ".join(facts.parts)
+        attrs["wavelengths_added_nm"] = np.asarray(config.added_wavelengths, dtype=float)
+    return attrs
+
+
+def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
+             threads: int | None = None, progress: bool = False, first_batch: int = 0,
              should_stop: Callable[[], bool] | None = None,
              on_checkpoint: Callable[[Result], None] | None = None,
              checkpoint_every_s: float = 60.0,
              resume_state: dict[str, np.ndarray] | None = None) -> Result:
-    """Runs a scene (a SceneConfig, a dict or a YAML path) and returns its Result.
+    """Runs a scene (a SceneConfig, a dict, a YAML path, or one prepare() packed) and returns
+    its Result.
 
     Batches first_batch .. batches-1 are traced, `threads` at a time (a resumed run starts
     after the whole batches it already has; batch b is the same whatever the start), continuing
@@ -146,7 +306,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     partial Result every checkpoint_every_s seconds. progress: a progress bar on stderr, and a
     notice there when the run looks like taking more than an hour. A NaN or inf in the
     tallies (a fault of oceanmc) raises NonFiniteResult, at the end or at a checkpoint."""
-    if not isinstance(config, SceneConfig):
+    if not isinstance(config, (PreparedRun, SceneConfig)):
         config = load_config(config)
     # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
     # number of cores) is the default and the most
@@ -156,172 +316,50 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
     # compiles the kernel (or loads it from the cache) before the scene is packed, which uses it
     trace = ready(should_stop)
     startup = time.perf_counter() - t0
-    data_hashes = data_file_hashes(config)   # before the build reads them
-    sc = scene.build(config)
-    check_tally_memory(config, sc)
+    run = config if isinstance(config, PreparedRun) else prepare(config)
+    config, sc = run.config, run.scene
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
-    n_batches = config.batches - first_batch
-    n_per_batch = math.ceil(config.photons / config.batches)
-    n_layers = len(config.water.layers)
-    config_layer = np.array([layer.config_layer for layer in sc.layers], dtype=np.int64)
-    depths = config.tallies.depths_m
-    # each batch's state between calls: random streams (the photons', then the inelastic
-    # emissions'), next photon (-1: not begun), entered sun beam (weight per sun packet,
-    # direction), scattering events, tally row
-    rngs = np.zeros((n_batches, RNG_STRIDE), dtype=np.uint64)
-    for b in range(n_batches):
-        rngs[b, :STATE_WORDS] = batch_state(config.seed, first_batch + b)
-        rngs[b, STATE_WORDS:RNG_WORDS] = batch_state(config.seed, first_batch + b, 1)
-    beams = np.zeros((n_batches, 4))
-    beams[:, 3] = 1.0
-    next_photon = np.full(n_batches, -1, dtype=np.int64)
-    # each batch's tally row and packet on cache lines of their own
-    tallies = np.zeros((n_batches, row_floats(sc.tally_size)))
-    events = np.zeros(n_batches, dtype=np.int64)
+    batches = Batches(run, first_batch)
     if resume_state is not None:
-        _restore(resume_state, first_batch, n_batches, sc.grid, rngs, beams, next_photon,
-                 events, tallies)
-    packets = np.zeros((n_batches, PACKET_STRIDE), dtype=PACKET)
-    # room for split copies and emitted packets waiting their turn (scratch, one per batch)
-    stack_rows = sc.stack_rows
-    stacks = np.zeros((n_batches, stack_rows), dtype=PACKET)
-    # the spectral state of the packet (row 0) and of its split copies (kernel/packet.py), and
-    # one event's scratch, each batch's on cache lines of its own
-    n_wl = len(config.wavelengths)
-    states = np.zeros((n_batches, stack_rows + 1, row_floats(packet_state_size(n_wl))))
-    work = np.zeros((n_batches, row_floats(work_size(n_wl))))
-    raws = [tally_views(sc.grid, tallies, j) for j in range(n_wl)]
-    # the parts of the tally row: the elastic light's, then each inelastic process's
-    part_names = ["elastic"] + ([name for name, _ in config.water.inelastic.processes()]
-                                if config.water.inelastic is not None else [])
-    ed0, diffuse, _ = illumination_spectrum(config)
-    # the resolved scene, with what a spectrum model or table gave (Ed0, diffuse share) noted
-    scene_yaml = config_to_yaml(config, (ed0, diffuse))
+        batches.restore(resume_state)
+    views = [tally_views(sc.grid, batches.tallies, j) for j in range(len(config.wavelengths))]
     args = sc.kernel_args()
-    # a batch's lock is held through each of its calls, so that a checkpoint copies its state
-    # between two calls
-    locks = [threading.Lock() for _ in range(n_batches)]
-    stopping = threading.Event()
-    photons_before = int(np.maximum(next_photon, 0).sum())
-
-    def run_batch(b: int) -> None:
-        budget = FIRST_BUDGET
-        while not stopping.is_set():
-            with locks[b]:
-                if next_photon[b] >= n_per_batch:
-                    return
-                t = time.perf_counter()
-                next_photon[b], n_events = trace(*args, n_per_batch, next_photon[b], budget,
-                                                 rngs[b, :STATE_WORDS],
-                                                 rngs[b, STATE_WORDS:RNG_WORDS], beams[b],
-                                                 tallies[b], packets[b, :1], stacks[b],
-                                                 states[b], work[b])
-                events[b] += n_events
-            budget = next_budget(budget, time.perf_counter() - t)
 
     def result_of(wall: float) -> Result:
         """The leading whole batches, and the state of the later ones begun."""
-        done = 0
-        while done < n_batches and next_photon[done] >= n_per_batch:
-            done += 1
-        begun = [b for b in range(done, n_batches) if next_photon[b] >= 0]
-        state = None
-        if begun:
-            # the tallies as named arrays (tally/flux, ...), not raw rows: the row's layout is
-            # the kernel's to change, a file's state stays readable
-            scores = tally_arrays(sc.grid, tallies)
-            state = {"batch": np.array(begun, dtype=np.int64) + first_batch,
-                     "rng": np.empty((len(begun), RNG_WORDS), dtype=np.uint64),
-                     "beam": np.empty((len(begun), 4)),
-                     "next_photon": np.empty(len(begun), dtype=np.int64),
-                     "events": np.empty(len(begun), dtype=np.int64)}
-            state.update({f"tally/{name}": np.empty((len(begun),) + values.shape[1:])
-                          for name, values in scores.items()})
-            for k, b in enumerate(begun):
-                with locks[b]:
-                    state["rng"][k] = rngs[b, :RNG_WORDS]
-                    state["beam"][k] = beams[b]
-                    state["next_photon"][k] = next_photon[b]
-                    state["events"][k] = events[b]
-                    for name, values in scores.items():
-                        state[f"tally/{name}"][k] = values[b]
-        photons = done * n_per_batch
-        attrs = {
-            "name": config.name,
-            "config_yaml": scene_yaml,
-            "data_files_sha256": data_hashes,
-            "oceanmc_version": __version__,
-            "numba_version": numba.__version__,
-            "seed": config.seed,
-            "photons": photons,
-            "batches": done,
-            "first_batch": first_batch,
-            "photons_per_batch": n_per_batch,
-            "partial": first_batch + done < config.batches,
-            "threads": n_threads,
-            "wall_time_s": wall,
-            "startup_time_s": startup,
-            "photons_per_s": photons / wall if wall > 0 else float("inf"),
-            "scattering_events": int(events[:done].sum()),
-            # Ed(0+) and its diffuse (sky) share per wavelength, as the run used them (from
-            # illumination's Ed0 and diffuse_fraction, or its spectrum model or table)
-            "illumination_Ed0": np.asarray(ed0, dtype=np.float64),
-            "illumination_diffuse_fraction": np.asarray(diffuse, dtype=np.float64),
-        }
-        if len(part_names) > 1:
-            # the outputs' parts (results.add_parts), and the wavelengths traced for the
-            # excitation of inelastic light beyond those asked for (config/inelastic.py)
-            attrs["inelastic_parts"] = " ".join(part_names)
-            attrs["wavelengths_added_nm"] = np.asarray(config.added_wavelengths, dtype=float)
-        reflected = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
+        done = batches.whole()
+        state = batches.unfinished(done)
+        attrs = run_attrs(run, batches, done, n_threads, wall, startup)
+        unit = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
-        per_wavelength = []
-        for k, raw in enumerate(raws):
-            parts = [{name.removeprefix(f"part{i}/"): values[:done]
-                      for name, values in raw.items()
-                      if (name.startswith(f"part{i}/") if i else "/" not in name)}
-                     for i in range(len(part_names))]
-            for part in parts:
-                part["budget"] = per_config_layer(part["budget"], config_layer, n_layers)
-            whole = {name: sum(part[name] for part in parts) for name in parts[0]}
-            if reflected is not None:
-                parts[0]["reflected_local"] = whole["reflected_local"] = \
-                    scene.surface.reflected_at(reflected, ed0[k], diffuse[k])
-
-            def derived(values):
-                return from_tallies(
-                    values, sc.angles, np.array(depths), n_per_batch, float(ed0[k]), n_layers,
-                    config.tallies.radiance, attrs, config.tallies.local_directions_deg,
-                    sc.local_rows, config.nadir_local, sun_of(config), len(parts) > 1)
-            result = derived(whole)
-            if len(parts) > 1:
-                add_parts(result, {name: derived(part) for name, part in zip(part_names, parts)})
-            per_wavelength.append(result)
-        # one wavelength: the monochromatic layout (no wavelength dimension)
-        result = per_wavelength[0] if n_wl == 1 else \
-            stack_wavelengths(per_wavelength, config.wavelengths)
+        reflected = None if unit is None else \
+            [scene.surface.reflected_at(unit, ed0, diffuse)
+             for ed0, diffuse in zip(run.facts.ed0, run.facts.diffuse)]
+        result = run_result(views, done, run.facts, attrs, reflected)
         # before a checkpoint or the end hands it on to be written or returned
         check_finite(result, config.wavelengths)
         result.resume_state = state
         result.iops = iops_table(sc.layers, config.wavelengths, sc.bottom_reflectance)
         return result
 
+    photons_before = batches.photons()
     t1 = last_checkpoint = time.perf_counter()
     estimated = False
-    with tqdm(total=n_batches * n_per_batch, initial=photons_before, unit="photon",
-              unit_scale=True, delay=1.0, disable=not progress, desc=config.name[:40],
-              leave=False) as bar, ThreadPoolExecutor(max_workers=n_threads) as pool:
+    with tqdm(total=len(batches) * batches.photons_per_batch, initial=photons_before,
+              unit="photon", unit_scale=True, delay=1.0, disable=not progress,
+              desc=config.name[:40], leave=False) as bar, \
+            ThreadPoolExecutor(max_workers=n_threads) as pool:
         # every batch queued at once, in order: they finish in about that order, so a stop
         # leaves few begun batches after the whole ones
-        futures = [pool.submit(run_batch, b) for b in range(n_batches)]
+        futures = [pool.submit(batches.trace, b, trace, args) for b in range(len(batches))]
         try:
             while True:
                 finished, running = wait(futures, timeout=POLL_SECONDS,
                                          return_when=FIRST_EXCEPTION)
                 for future in finished:
                     future.result()   # a batch's exception, raised here
-                photons_now = int(np.maximum(next_photon, 0).sum())
+                photons_now = batches.photons()
                 bar.update(photons_now - bar.n)
                 if not running:
                     break
@@ -332,7 +370,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                         and photons_now > photons_before:
                     estimated = True
                     rate = (photons_now - photons_before) / (now - t1)
-                    left = (n_batches * n_per_batch - photons_now) / rate
+                    left = (len(batches) * batches.photons_per_batch - photons_now) / rate
                     if left > LONG_RUN_S:
                         bar.write(f"oceanmc: {config.name}: about {_duration(left)} to go at "
                                   f"{rate:,.0f} photons/s; Ctrl-C stops it within seconds and "
@@ -342,7 +380,7 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
                     last_checkpoint = now
         finally:
             # the calls in flight end within about CALL_SECONDS; batches not begun never start
-            stopping.set()
+            batches.stopping.set()
             for future in futures:
                 future.cancel()
             wait(futures)
@@ -350,29 +388,3 @@ def simulate(config: SceneConfig | dict[str, Any] | str | Path, *, threads: int 
         if not future.cancelled():
             future.result()
     return result_of(time.perf_counter() - t1)
-
-
-def _restore(state: dict[str, np.ndarray], first_batch: int, n_batches: int,
-             grid_record: np.ndarray, rngs, beams, next_photon, events, tallies) -> None:
-    """Puts a partial run's unfinished batches (Result.resume_state) back where they stopped,
-    their tally rows rebuilt from the named score arrays. Raises MergeError (one line: the CLI's
-    --resume says it and exits 2) when those arrays or batches are not this scene's."""
-    rows = np.zeros((len(state["batch"]), tallies.shape[1]))
-    try:
-        write_tally_arrays(grid_record, {key.removeprefix("tally/"): values
-                                         for key, values in state.items()
-                                         if key.startswith("tally/")}, rows)
-    except ValueError as exc:
-        raise MergeError(f"the stored unfinished batches' tallies do not fit this scene: "
-                         f"{exc}") from None
-    for k, batch in enumerate(state["batch"]):
-        b = int(batch) - first_batch
-        if not 0 <= b < n_batches:
-            raise MergeError(f"stored unfinished batch {batch} is outside {first_batch} .. "
-                             f"{first_batch + n_batches - 1}")
-        # (a file from before the second stream holds the first only: the second starts anew)
-        rngs[b, :state["rng"].shape[1]] = state["rng"][k]
-        beams[b] = state["beam"][k]
-        next_photon[b] = state["next_photon"][k]
-        events[b] = state["events"][k]
-        tallies[b] = rows[k]

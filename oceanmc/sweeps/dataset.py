@@ -17,8 +17,11 @@ import numpy as np
 import yaml
 
 from .. import __version__
-from ..run.hdf5 import COORD_UNITS, load_result, place_atomically
-from ..run.results import Result, merge_results, scene_difference
+from ..run.format import COORD_UNITS
+from ..run.hdf5 import load_result
+from ..run.merge import merge_results, scene_difference
+from ..run.placement import place_atomically
+from ..run.result import Result
 from .axes import SweepError, SweepSpec, coordinate, load_sweep
 from .points import Point
 

@@ -1,0 +1,89 @@
+"""The result model: a run's quantities, each with its per-batch values, and what the run was.
+
+Every quantity keeps its per-batch values (leading `batch` axis); the estimate is the mean over
+batches and its standard error the sample standard deviation over sqrt(batches). Because the
+batch values are stored, results of independent runs merge by concatenating batches (merge.py).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .format import save_result
+
+
+@dataclass
+class Quantity:
+    name: str                 # path in the file: "Ed", "air/Lw", "budget/water_leaving"
+    dims: tuple[str, ...]     # dimensions of the estimate (without the batch axis)
+    batches: np.ndarray       # (batch, *dims)
+    units: str
+    description: str
+
+    @property
+    def mean(self) -> np.ndarray:
+        if self.batches.shape[0] == 0:   # a run stopped before its first batch was whole
+            return np.full(self.batches.shape[1:], np.nan)
+        return self.batches.mean(axis=0)
+
+    @property
+    def stderr(self) -> np.ndarray:
+        n = self.batches.shape[0]
+        if n < 2:
+            return np.full(self.batches.shape[1:], np.nan)
+        # the deviations are divided by their largest magnitude before they are squared:
+        # squared unscaled, deviations below about 1e-154 underflow to 0 (a standard error of
+        # exactly 0 for a tiny quantity) and those above about 1e154 overflow
+        deviations = self.batches - self.batches.mean(axis=0)
+        scale = np.abs(deviations).max(axis=0)
+        safe = np.where(scale > 0.0, scale, 1.0)
+        spread = np.sqrt(((deviations / safe) ** 2).sum(axis=0) / (n - 1))
+        return scale * spread / math.sqrt(n)
+
+
+@dataclass
+class Result:
+    coords: dict[str, np.ndarray]
+    quantities: dict[str, Quantity]
+    attrs: dict[str, object] = field(default_factory=dict)
+    # a partial run's unfinished batches, from which --resume continues them (simulation.py)
+    resume_state: dict[str, np.ndarray] | None = None
+    # the IOPs the run used (optics.iops_table): a, b, bb, c (layer, wavelength) in 1/m and the
+    # coordinates layer_top (m), layer_thickness (m), wavelength (nm), and the bottom's
+    # reflectance (wavelength) where it has one; the file's group `iops`
+    iops: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.quantities[name].mean
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.quantities
+
+    def stderr(self, name: str) -> np.ndarray:
+        return self.quantities[name].stderr
+
+    @property
+    def config_yaml(self) -> str:
+        return str(self.attrs["config_yaml"])
+
+    def save(self, path: str | Path, overwrite: bool = True) -> Path:
+        """Writes the results file (format.save_result); overwrite=False: never replace an
+        existing file (placement.place_atomically)."""
+        return save_result(self, path, overwrite)
+
+
+# ratios derivation.from_tallies leaves out of a Result where their denominator is 0 in a batch
+# (there is no value to give: 0/0): air/t_up without upwelling light at 0-, air/rho_local
+# without sky light. The wavelengths of a spectral run, and runs of one scene, may differ in
+# these only (a batch of very absorbing water may have no upwelling photon where another has some)
+UNDEFINED_RATIOS = frozenset({"air/t_up", "air/rho_local"})
+
+
+def common_quantities(parts: list[Result]) -> set[str]:
+    """The quantities every part holds: a ratio of UNDEFINED_RATIOS that some part (a
+    wavelength of a spectral run, a run to merge) lacks is left out of the whole, as a run
+    leaves it out when one of its batches lacks it."""
+    return set.intersection(*(set(p.quantities) for p in parts))

@@ -1,0 +1,378 @@
+"""The printed summary of a Result (`oceanmc run`, `merge`, `show`): the headline quantities
+with their standard errors, one row each for a monochromatic run and a table by wavelength for a
+spectral one, with inelastic light its parts of Rrs nadir, and what the estimators, the
+processes and the illumination were."""
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+
+from .derivation import budget_terms
+from .result import Result
+
+
+def nadir_estimate(result: Result) -> str:
+    """How Lu, air/Lw_nadir and air/Rrs_nadir were estimated: 'local' (the polar cap's local,
+    next-event estimate; with radiance quads the crossing estimates are beside them as
+    *_crossing) or 'crossing' (the attribute Lu_method says which)."""
+    method = str(result.attrs.get("Lu_method", ""))
+    local = "local (next-event)" in method if method else "air/Rrs_nadir_crossing" in result
+    return "local" if local else "crossing"
+
+
+def direction_label(result: Result, k: int) -> str:
+    """`180,0`: the exact direction k of local_directions_deg (theta, phi of travel, deg)."""
+    return f"{result.coords['direction_theta'][k]:g},{result.coords['direction_phi'][k]:g}"
+
+
+def local_directions(result: Result) -> range:
+    """The indices of the exact directions with local estimates in air (none: empty)."""
+    return range(len(result.coords.get("direction_theta", ())) if "air/Rrs_local" in result
+                 else 0)
+
+
+def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
+    """(label, units, value, standard error) for the headline quantities of a run; the nadir
+    quantities name their estimator (local or crossing), and each exact direction of
+    local_directions_deg has its Rrs row."""
+    rows = []
+    how = f"({nadir_estimate(result)})"
+
+    def row(label, name, units, index=None):
+        if name not in result:
+            return
+        value, err = result[name], result.stderr(name)
+        if index is not None:
+            value, err = value[index], err[index]
+        rows.append((label, units, float(value), float(err)))
+
+    row("Ed(0+)", "air/Ed", "W/m2")
+    row("Eu(0+)", "air/Eu", "W/m2")
+    row("Lu(0+) nadir (crossing)", "air/Lu", "W/m2/sr")
+    row(f"Lw nadir {how}", "air/Lw_nadir", "W/m2/sr")
+    row(f"Rrs nadir {how}", "air/Rrs_nadir", "1/sr")
+    for k in local_directions(result):
+        row(f"Rrs {direction_label(result, k)} (local)", "air/Rrs_local", "1/sr", k)
+    for i, depth in enumerate(result.coords["depth"]):
+        where = "0-" if depth == 0.0 else f"{depth:g} m"
+        row(f"Ed({where})", "Ed", "W/m2", i)
+        row(f"Eu({where})", "Eu", "W/m2", i)
+        row(f"Eo({where})", "Eo", "W/m2", i)
+        row(f"Lu({where}) {how}", "Lu", "W/m2/sr", i)
+    # the budget in the order of budget_terms, as a run makes it (a file read back lists its
+    # datasets alphabetically): one order for `run` and `show`
+    budget = [name for name in result.quantities if name.startswith("budget/")]
+    n_layers = sum(name.startswith("budget/absorbed_layer_") for name in budget)
+    order = [f"budget/{term}" for _, term, _ in budget_terms(n_layers)] + ["budget/total"]
+    for name in order + [name for name in budget if name not in order]:
+        row("budget " + name.split("/", 1)[1], name, "1")
+    return rows
+
+
+def estimator_lines(result: Result) -> list[str]:
+    """What the nadir and exact-direction columns or rows are: their quantities, and their
+    estimators."""
+    edges = result.coords.get("theta_edges")
+    cap = f"the {edges[-2]:g}-180 deg polar cap's average" if edges is not None \
+        and len(edges) > 1 else "the nadir polar cap's average"
+    said = []
+    if "air/Rrs_nadir" in result:
+        if nadir_estimate(result) == "local":
+            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate"
+                        + (" (air/Rrs_nadir_crossing: the crossing estimate)"
+                           if "air/Rrs_nadir_crossing" in result else ""))
+        else:
+            said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
+                        f"through the cap{local_nadir_hint(result)})")
+    ks = local_directions(result)
+    if len(ks):
+        which = ", ".join(f"Rrs {direction_label(result, k)}" for k in ks)
+        said.append(f"{which}: air/Rrs_local in the exact direction{'s' if len(ks) > 1 else ''} "
+                    "(theta, phi of travel, deg) of tallies.local_directions_deg, local "
+                    "(next-event) estimate: heavy-tailed with forward-peaked phase functions "
+                    "(Petzold, Fournier-Forand), whose error bars may understate it")
+    return [line for text in said
+            for line in textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ")]
+
+
+def local_nadir_hint(result: Result) -> str:
+    """What the crossing estimate's summary line adds: how to get the cap's local estimate, or
+    why the scene cannot have it."""
+    import yaml
+    from pydantic import TypeAdapter
+
+    from ..config import Bottom, Surface, bottom_has_mirror
+    from ..config.surface import MAX_CAP_MSS
+    try:
+        scene = yaml.safe_load(result.config_yaml)
+        surface = Surface(**scene["surface"])
+        bottom = TypeAdapter(Bottom).validate_python(scene["bottom"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return ""
+    if bottom_has_mirror(bottom):
+        return "; a mirror bottom has no density for the local estimate"
+    if not surface.cap_lobe_tabulated():
+        return ("; the cap's local estimate through waves needs isotropic slopes (no "
+                f"wind_direction_deg) of mean square slope <= {MAX_CAP_MSS}")
+    return "; tallies.nadir_estimator: local gives the cap's local estimate"
+
+
+def illumination_lines(result: Result) -> list[str]:
+    """Where Ed(0+) came from, for a spectral file: the sun, the spectrum model or table and
+    the sky's share of Ed(0+) over the band (none if the file does not say)."""
+    import yaml
+    try:
+        light = yaml.safe_load(result.config_yaml)["illumination"]
+        model = light["spectrum"]["model"]
+        zenith = float(light["sun_zenith_deg"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return []
+    diffuse = np.atleast_1d(result.attrs.get("illumination_diffuse_fraction", []))
+    wl = result.coords["wavelength"]
+    where = "sun_position" if light.get("sun_position") else "sun_zenith_deg"
+    line = f"illumination: sun at {zenith:.2f} deg from the zenith ({where}), spectrum {model}"
+    if len(diffuse) == len(wl) and len(wl):
+        line += (f"; sky share of Ed(0+) {diffuse[0]:.3f} at {wl[0]:g} nm .. {diffuse[-1]:.3f} "
+                 f"at {wl[-1]:g} nm, mean {diffuse.mean():.3f}")
+        if model != "flat":
+            line += " (per wavelength: `oceanmc show FILE --config`)"
+    return textwrap.wrap(line, 100, initial_indent="  ", subsequent_indent="    ")
+
+
+# the columns of a spectral run's table: (heading, quantity, depth index or None); the exact
+# directions of local_directions_deg follow Rrs nadir
+SPECTRAL_COLUMNS = (("Ed(0+)", "air/Ed", None), ("Rrs nadir", "air/Rrs_nadir", None),
+                    ("Eu(0+)", "air/Eu", None),
+                    ("Ed(z1)", "Ed", 0), ("Eu(z1)", "Eu", 0), ("Eo(z1)", "Eo", 0),
+                    ("leaving", "budget/water_leaving", None), ("total", "budget/total", None))
+
+
+# the printed summary fits a terminal this wide: a spectral table's nm column (8 characters)
+# and SPECTRAL_BLOCK columns of 16 (a value, its relative standard error)
+SUMMARY_WIDTH = 100
+SPECTRAL_BLOCK = (SUMMARY_WIDTH - 8) // 16
+
+
+def value_cell(value: float, err: float) -> str:
+    """A spectral table's cell of 15 characters: the value and its relative standard error in %
+    (0.0% for a value of 0)."""
+    rel = abs(err / value) if value != 0.0 else 0.0
+    return f"{value:>9.4g} {rel:>5.1%}"
+
+
+# the parts of the light (add_parts) as the summary's headings and the plots' legends name them
+PART_LABELS = {"elastic": "elastic", "raman": "Raman",
+               "chlorophyll_fluorescence": "fluorescence"}
+
+
+def light_parts(result: Result) -> list[str]:
+    """The parts of a run with inelastic light (attribute inelastic_parts: elastic, then each
+    process); [] without inelastic light."""
+    parts = str(result.attrs.get("inelastic_parts", "")).split()
+    return parts if len(parts) > 1 else []
+
+
+def lowest_requested(wavelengths: np.ndarray, added: np.ndarray) -> float:
+    """The lowest wavelength (nm) the scene asked for, of a grid that also holds the wavelengths
+    a run added for the excitation of inelastic light."""
+    return float(min(w for w in wavelengths if not np.isclose(added, w).any()))
+
+
+def wavelength_ranges(wavelengths: np.ndarray) -> str:
+    """Sorted wavelengths in few words: runs of three or more at one step as '340-390 nm
+    (10 nm steps)', the others one by one ('405 nm')."""
+    pieces = []
+    start = 0
+    while start < len(wavelengths):
+        end = start + 1   # the run is wavelengths[start:end]
+        step = wavelengths[end] - wavelengths[start] if end < len(wavelengths) else 0.0
+        while end < len(wavelengths) and np.isclose(wavelengths[end] - wavelengths[end - 1],
+                                                    step):
+            end += 1
+        if end - start >= 3:
+            pieces.append(f"{wavelengths[start]:g}-{wavelengths[end - 1]:g} nm ({step:g} nm "
+                          "steps)")
+        else:   # two at one step: the first alone, the second may begin a run
+            end = start + 1
+            pieces.append(f"{wavelengths[start]:g} nm")
+        start = end
+    return ", ".join(pieces)
+
+
+def process_descriptions(result: Result) -> list[str]:
+    """Each inelastic process of a run with its settings, as the stored scene has them (with
+    the defaults filled in), so that a comparison (e.g. with HydroLight) can check them; the
+    parts' names alone where the stored scene cannot be read."""
+    import yaml
+
+    from ..config.inelastic import Inelastic
+    try:
+        inelastic = Inelastic(**yaml.safe_load(result.config_yaml)["water"]["inelastic"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return [PART_LABELS.get(part, part) for part in light_parts(result)[1:]]
+    said = []
+    for name, process in inelastic.processes():
+        if name == "raman":
+            said.append(f"Raman scattering by water (b_R {process.b488_per_m:g} 1/m at 488 nm, "
+                        f"as (488/l)^{process.exponent:g})")
+        elif name == "chlorophyll_fluorescence":
+            low, high = process.excitation_range_nm
+            said.append(f"chlorophyll fluorescence (quantum yield {process.quantum_yield:g}, "
+                        f"{process.peak_nm:g} nm, sigma {process.sigma_nm:g} nm, excited "
+                        f"{low:g}-{high:g} nm)")
+        else:
+            said.append(PART_LABELS.get(name, name))
+    return said
+
+
+def inelastic_lines(result: Result) -> list[str]:
+    """For a run with inelastic light: the processes that were on, the parts every quantity is
+    split into, and the wavelengths traced beyond those asked for (attribute
+    wavelengths_added_nm), whose own inelastic light lacks what would be excited below the
+    traced grid (Raman light at 370 nm comes from 323-335 nm). [] without inelastic light."""
+    parts = light_parts(result)
+    if not parts:
+        return []
+    said = [f"inelastic light: {', '.join(process_descriptions(result))}; every quantity but "
+            "the ratios is also split into parts that add up to it: "
+            f"{', '.join(p + '/' for p in parts)} (e.g. {parts[1]}/air/Rrs_nadir)"]
+    if "wavelengths_added_nm" in result.attrs:
+        added = np.atleast_1d(np.asarray(result.attrs["wavelengths_added_nm"], dtype=float))
+        wavelengths = result.coords["wavelength"]
+        if len(added) == 0:
+            said.append("traced no wavelength beyond those asked for: they hold the excitation "
+                        "of the inelastic light")
+        else:
+            first = lowest_requested(wavelengths, added)
+            below = f", though those below {first:g} nm lack the inelastic light excited " \
+                f"below {wavelengths[0]:g} nm" if (added < first).any() else ""
+            said.append(f"traced also {wavelength_ranges(np.sort(added))} for the excitation "
+                        f"of inelastic light; reported with the rest{below}")
+    return [line for text in said
+            for line in textwrap.wrap(text, SUMMARY_WIDTH, initial_indent="  ",
+                                      subsequent_indent="    ")]
+
+
+def rrs_parts_table(result: Result) -> list[str]:
+    """For a run with inelastic light: Rrs nadir of each part of the light per wavelength, its
+    relative standard error and its share of the whole Rrs nadir; [] without inelastic light or
+    without Rrs nadir. The elastic part and both processes fit SUMMARY_WIDTH (77 characters)."""
+    parts = [part for part in light_parts(result) if f"{part}/air/Rrs_nadir" in result]
+    if not parts or "air/Rrs_nadir" not in result:
+        return []
+    whole = result["air/Rrs_nadir"]
+    head = ("Rrs nadir by part of the light: value, relative standard error and share of the "
+            f"whole ({', '.join(f'{p}/air/Rrs_nadir' for p in parts)})")
+    lines = [""] + textwrap.wrap(head, SUMMARY_WIDTH, initial_indent="  ",
+                                 subsequent_indent="  ")
+    lines.append(f"  {'nm':>6}" + "".join(f" {PART_LABELS.get(p, p):>15} {'share':>6}"
+                                          for p in parts))
+    for k, wavelength in enumerate(result.coords["wavelength"]):
+        row = f"  {wavelength:>6g}"
+        for part in parts:
+            value = result[f"{part}/air/Rrs_nadir"][k]
+            share = value / whole[k] if whole[k] != 0.0 else 0.0
+            row += f" {value_cell(value, result.stderr(f'{part}/air/Rrs_nadir')[k]):>15}" \
+                f" {share:>6.1%}"
+        lines.append(row)
+    return lines
+
+
+def format_spectrum(result: Result) -> list[str]:
+    """A spectral run as a table: one row per wavelength, the headline quantities in columns
+    (z1: the first tally depth), each value with its relative standard error in %, in blocks of
+    columns no wider than SUMMARY_WIDTH, and with inelastic light Rrs nadir by part of the light;
+    then what the Rrs columns are (their estimators), the inelastic processes and the wavelengths
+    added for them, and where the light came from."""
+    depths = result.coords["depth"]
+    first = "0-" if depths[0] == 0.0 else f"{depths[0]:g} m"
+    columns = []
+    for head, name, index in SPECTRAL_COLUMNS:
+        if name in result:
+            columns.append((head.replace("z1", first), name, (slice(None), index)))
+        if name == "air/Rrs_nadir":
+            columns += [(f"Rrs {direction_label(result, k)}", "air/Rrs_local", (slice(None), k))
+                        for k in local_directions(result)]
+    cells = []   # per column: its cell per wavelength
+    for _, name, (_, index) in columns:
+        column = []
+        for k in range(len(result.coords["wavelength"])):
+            value, err = result[name][k], result.stderr(name)[k]
+            if index is not None:
+                value, err = value[index], err[index]
+            column.append(value_cell(value, err))
+        cells.append(column)
+    # the table is printed in blocks of at most SPECTRAL_BLOCK columns, each after the nm
+    # column, so that a line fits a terminal of SUMMARY_WIDTH characters: the quantities at
+    # the surface (Ed(0+), the Rrs columns, Eu(0+)) first, then those in the water and the budget
+    surface = next(i for i, (_, name, _) in enumerate(columns + [("", "Ed", 0)])
+                   if name in ("Ed", "Eu", "Eo") or name.startswith("budget/"))
+    blocks = [range(start, min(start + SPECTRAL_BLOCK, end))
+              for begin, end in ((0, surface), (surface, len(columns)))
+              for start in range(begin, end, SPECTRAL_BLOCK)]
+    lines = []
+    for b, block in enumerate(blocks):
+        if b:
+            lines.append("")
+        lines.append(f"  {'nm':>6}" + "".join(f" {columns[c][0]:>15}" for c in block))
+        lines += [f"  {wavelength:>6g}" + "".join(f" {cells[c][k]:>15}" for c in block)
+                  for k, wavelength in enumerate(result.coords["wavelength"])]
+    lines += rrs_parts_table(result)
+    lines += estimator_lines(result)
+    lines += inelastic_lines(result)
+    lines += illumination_lines(result)
+    lines.append("  (value and relative standard error; irradiances in the units of Ed(0+), "
+                 "Rrs in 1/sr,")
+    lines.append("  budget fractions of Ed(0+); every quantity per wavelength in the file)")
+    return lines
+
+
+# standard errors from fewer batches than this are themselves too uncertain to trust: from n
+# batches the standard error's own relative error is about 1 / sqrt(2 (n - 1)), 38% at 4
+RELIABLE_BATCHES = 8
+
+
+def completeness_line(result: Result) -> str | None:
+    """One line on a partial file (N of M batches whole) and on standard errors from fewer than
+    RELIABLE_BATCHES batches; None for a complete file of enough batches."""
+    a = result.attrs
+    done = int(a["batches"])
+    if not a.get("partial", False) and done >= RELIABLE_BATCHES:
+        return None
+    import yaml
+    total = None
+    try:
+        total = int(yaml.safe_load(result.config_yaml)["batches"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        pass
+    of = f" of {total}" if total is not None else ""
+    head = f"  PARTIAL: {done}{of} batches whole (a stopped run; the estimates use them only)" \
+        if a.get("partial", False) else f"  note: {done} batches"
+    if done == 0:
+        return head + "; no batch is whole yet: the file holds no estimate, only the state to " \
+            "resume from"
+    if done < RELIABLE_BATCHES:
+        return head + f"; standard errors from fewer than {RELIABLE_BATCHES} batches are " \
+            "unreliable"
+    return head
+
+
+def format_summary(result: Result) -> str:
+    a = result.attrs
+    lines = [
+        f"{a.get('name', '')}",
+        f"  {a['photons']:,} photons in {a['batches']} batches on {a['threads']} thread(s): "
+        f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
+        f"(start-up {a['startup_time_s']:.2f} s)",
+    ]
+    said = completeness_line(result)
+    if said is not None:
+        lines.append(said)
+    if "wavelength" in result.coords:
+        return "\n".join(lines + format_spectrum(result))
+    lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}")
+    for label, units, value, err in summary_rows(result):
+        rel = abs(err / value) if value != 0.0 else 0.0
+        lines.append(f"  {label:<28}{units:<9}{value:>13.6g}{err:>12.3g}{rel:>10.2%}")
+    return "\n".join(lines)
