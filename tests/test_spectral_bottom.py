@@ -3,7 +3,9 @@ lambertian, minnaert and specular bottoms as one number, one per wavelength or a
 and areal mixtures of one shape (config/bottom.py, optics/bottom.py). The kernel runs one BRDF
 of the largest reflectance R_max and gives wavelength j the share R_j / R_max (GRID bottom_q;
 kernel/spectral.py reflect and bottom_weights): the packing is checked here, and a spectral run
-against single-wavelength runs of each wavelength's reflectance (z-scores, fixed seeds)."""
+against single-wavelength runs of each wavelength's reflectance (z-scores, fixed seeds). The
+albedo_scale of ggx, hapke and table and the parts of lambertian_specular:
+test_spectral_bottom_shapes.py."""
 import copy
 
 import h5py
@@ -48,9 +50,11 @@ def packed(config):
     bottom, shares = kernel_bottom(config.bottom, config.wavelengths)
     sc = scene.build(config)
     g = sc.grid[0]
-    q = sc.floats[g["bottom_q"]:g["bottom_q"] + int(g["n_wl"])]
-    np.testing.assert_array_equal(q, shares)
-    return bottom, shares, sc.floats[sc.bottom[0]["params"]:sc.bottom[0]["params"] + 2]
+    q = sc.floats[g["bottom_q"]:g["bottom_q"] + 2 * int(g["n_wl"])]
+    np.testing.assert_array_equal(q, shares.ravel())
+    # every bottom but lambertian_specular has one row of shares (its second row the same)
+    np.testing.assert_array_equal(shares[1], shares[0])
+    return bottom, shares[0], sc.floats[sc.bottom[0]["params"]:sc.bottom[0]["params"] + 2]
 
 
 def spectrum_csv(path, rows):
@@ -132,13 +136,10 @@ def test_the_new_users_reflectance_list_is_accepted():
         {"fraction": 1.0, "model": "lambertian", "reflectance": [0.3, 0.2]}]},
      ("bottom.components[0].reflectance has 2 values",)),
     ({"model": "ggx", "roughness": 0.3, "diffuse_reflectance": [0.1, 0.2, 0.3]},
-     ("bottom.diffuse_reflectance", "'ggx' takes one value, not a list",
-      "offered for lambertian, minnaert and specular bottoms")),
+     ("bottom.diffuse_reflectance", "'ggx' takes one diffuse_reflectance, not a list",
+      "give albedo_scale")),
     ({"model": "hapke", "albedo": {"file": "sand.csv"}},
-     ("bottom.albedo", "'hapke' takes one value, not a spectrum file", "not yet offered")),
-    ({"model": "lambertian_specular", "diffuse_reflectance": [0.1, 0.2, 0.3],
-      "specular_reflectance": 0.1},
-     ("bottom.diffuse_reflectance", "'lambertian_specular' takes one value")),
+     ("bottom.albedo", "'hapke' takes one albedo, not a spectrum file", "give albedo_scale")),
 ])
 def test_refusals_are_one_line_naming_the_key(bottom, words):
     refused(scene_dict(bottom), *words)
@@ -176,6 +177,7 @@ def test_one_reflectance_packs_as_before():
     np.testing.assert_array_equal(number.floats, one.floats)
     g = number.grid[0]
     assert number.floats[g["bottom_q"]] == 1.0 and number.floats[number.bottom[0]["params"]] == 0.2
+    assert number.floats[g["bottom_q"] + 1] == 1.0   # the mirror lobe's row
     _, shares, _ = packed(scene_dict({"model": "lambertian", "reflectance": 0.2}))
     np.testing.assert_array_equal(shares, np.ones(3))
     _, shares, params = packed(scene_dict({"model": "lambertian", "reflectance": [0, 0, 0]}))

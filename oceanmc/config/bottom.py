@@ -35,26 +35,35 @@ class ReflectanceSpectrum(_Strict):
 
 
 # A bottom reflectance that may vary with wavelength: one number, one per wavelength, or
-# {file: CSV}. Only BRDFs whose angular shape does not depend on the reflectance take it: the
-# spectral walk (kernel/spectral.py) samples one BRDF shape for every wavelength and gives
-# wavelength j the share R_j / R_max of the packed BRDF's reflectance (GRID bottom_q;
-# optics/bottom.py packs it).
+# {file: CSV}. The spectral walk (kernel/spectral.py) samples one BRDF for every wavelength and
+# gives wavelength j the share R_j / R_packed of the packed BRDF's reflectance (GRID bottom_q;
+# optics/bottom.py packs it): exact where the angular shape does not depend on R (lambertian,
+# minnaert, specular, and the albedo_scale of ggx, hapke and table), and per lobe for
+# lambertian_specular (the diffuse lobe's shares, and the mirror lobe's used when the mirror
+# was sampled).
 Reflectance = spectral(Fraction, table=ReflectanceSpectrum)
 SPECTRAL_MODELS = ("lambertian", "minnaert", "specular")
+# the largest albedo_scale: a GGX with Fresnel facets reflects ~0.005, so scales of ~100 are
+# physical; rho_dh <= 1 is checked per wavelength when the scene is built
+MAX_ALBEDO_SCALE = 1000.0
+# ggx, hapke, table: their f times albedo_scale at each wavelength (a CSV spectrum's values lie
+# within 0 .. 1, as every reflectance spectrum's)
+AlbedoScale = spectral(Annotated[float, Field(gt=0.0, le=MAX_ALBEDO_SCALE, allow_inf_nan=False)],
+                       table=ReflectanceSpectrum)
+SCALED_MODELS = ("ggx", "hapke", "table")
 
 
-def _one_value(model: str):
-    """A reflectance parameter of a BRDF whose shape changes with it: a list or a spectrum is
-    refused in one line saying what is offered."""
+def _one_value(model: str, key: str):
+    """A parameter of a BRDF whose angular shape changes with it: a list or a spectrum is
+    refused in one line saying what is offered instead (albedo_scale)."""
     def check(value):
         if isinstance(value, (list, dict)):
             given = "a list" if isinstance(value, list) else "a spectrum file"
             raise ValueError(
-                f"bottom.model {model!r} takes one value, not {given}: a reflectance that "
-                "varies with wavelength is offered for lambertian, minnaert and specular "
-                f"bottoms (and mixtures of lambertian or minnaert ones); {model}'s angular "
-                "shape changes with its reflectance, which would need a BRDF evaluated per "
-                "wavelength in the kernel (not yet offered)")
+                f"bottom.model {model!r} takes one {key}, not {given}: {model}'s angular shape "
+                f"changes with {key}, and the spectral walk samples one shape for every "
+                "wavelength; for a reflectance that varies with wavelength give albedo_scale "
+                "(a number, one per wavelength or {file: CSV}: the BRDF times it)")
         return value
     return BeforeValidator(check)
 
@@ -84,10 +93,11 @@ class SpecularBottom(_Strict):
 
 
 class LambertianSpecularBottom(_Strict):
-    """diffuse_reflectance/pi + specular_reflectance x mirror; rho_dh is their sum."""
+    """diffuse_reflectance/pi + specular_reflectance x mirror; rho_dh is their sum (at each
+    wavelength: each part a number, one per wavelength or a spectrum)."""
     model: Literal["lambertian_specular"]
-    diffuse_reflectance: Annotated[Fraction, _one_value("lambertian_specular")]
-    specular_reflectance: Annotated[Fraction, _one_value("lambertian_specular")]
+    diffuse_reflectance: Reflectance
+    specular_reflectance: Reflectance
     allow_unphysical: bool = False
 
 
@@ -99,7 +109,8 @@ class GGXBottom(_Strict):
     roughness: Annotated[float, Field(ge=0.01, le=1.0, allow_inf_nan=False)]
     n_ratio: Annotated[float, Field(gt=1.0, le=10.0, allow_inf_nan=False)] = 1.15
     fresnel: bool = True
-    diffuse_reflectance: Annotated[Fraction, _one_value("ggx")] = 0.0
+    diffuse_reflectance: Annotated[Fraction, _one_value("ggx", "diffuse_reflectance")] = 0.0
+    albedo_scale: AlbedoScale = 1.0
     sampling: Sampling = "auto"
     allow_unphysical: bool = False
 
@@ -109,10 +120,12 @@ class HapkeBottom(_Strict):
     (kernel/brdf/hapke.py): grain single-scattering albedo, Henyey-Greenstein asymmetry of the
     grains (negative: backward), opposition surge amplitude B0 and width h."""
     model: Literal["hapke"]
-    albedo: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False), _one_value("hapke")]
+    albedo: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False),
+                      _one_value("hapke", "albedo")]
     asymmetry: Asymmetry = 0.0
     opposition_amplitude: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 0.5
     opposition_width: Annotated[float, Field(gt=0.0, le=2.0, allow_inf_nan=False)] = 0.06
+    albedo_scale: AlbedoScale = 1.0
     allow_unphysical: bool = False
 
 
@@ -124,6 +137,7 @@ class TableBottom(_Strict):
     file: FilePath
     quantity: Literal["brdf", "reflectance_factor"] = "brdf"
     reciprocity_tolerance: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.05
+    albedo_scale: AlbedoScale = 1.0
     allow_unphysical: bool = False
 
 
@@ -205,7 +219,20 @@ def reflectance_keys(bottom) -> list[tuple[str, object]]:
                 for i, c in enumerate(bottom.components)]
     if bottom.model in SPECTRAL_MODELS:
         return [("bottom.reflectance", bottom.reflectance)]
+    if bottom.model == "lambertian_specular":
+        return [("bottom.diffuse_reflectance", bottom.diffuse_reflectance),
+                ("bottom.specular_reflectance", bottom.specular_reflectance)]
+    if bottom.model in SCALED_MODELS:
+        return [("bottom.albedo_scale", bottom.albedo_scale)]
     return []
+
+
+def _largest(value) -> float:
+    """The largest value a spectral key can take: a number, a list's largest, 1 for a spectrum
+    file (its values lie within 0 .. 1)."""
+    if isinstance(value, list):
+        return max(value)
+    return 1.0 if isinstance(value, ReflectanceSpectrum) else value
 
 
 def check_bottom_wavelengths(bottom, n_wavelengths: int, spectral: bool) -> None:
@@ -224,7 +251,7 @@ def bottom_has_mirror(bottom) -> bool:
     local (next-event) estimate cannot evaluate."""
     if bottom.model == "specular":
         return True
-    return bottom.model == "lambertian_specular" and bottom.specular_reflectance > 0.0
+    return bottom.model == "lambertian_specular" and _largest(bottom.specular_reflectance) > 0.0
 
 
 def bottom_weight_bounded(bottom) -> bool:
@@ -232,4 +259,7 @@ def bottom_weight_bounded(bottom) -> bool:
     reflection survives with probability = weight, so it needs this)."""
     if bottom.model in ("hapke", "table") or getattr(bottom, "sampling", "auto") == "tabulated":
         return False
-    return not (bottom.model == "ggx" and bottom.diffuse_reflectance > 0.0)
+    # GGX without a Lambertian term weighs F G2 / G1 <= 1 at albedo_scale 1: times the packed
+    # scale, the largest over the wavelengths (optics/bottom.py)
+    return not (bottom.model == "ggx" and (bottom.diffuse_reflectance > 0.0
+                                          or _largest(bottom.albedo_scale) > 1.0))

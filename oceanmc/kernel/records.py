@@ -109,7 +109,8 @@ SKY = _record(
 #   (0+, water-leaving light only).
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
 #               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths),
-#               source_q (2 x n_wl: sun, sky), bottom_q (n_wl) (kernel/spectral.py)
+#               source_q (2 x n_wl: sun, sky), bottom_q (2 x n_wl: every lobe, a
+#               lambertian_specular bottom's mirror lobe) (kernel/spectral.py)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
 #   tally row:  the local estimates' scores, local ((n_depths + 1) x n_dirs x n_wl) and cap
 #               ((n_depths + 1) x n_wl); then, from `scores` on, flux (n_levels x 4),

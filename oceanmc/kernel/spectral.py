@@ -258,7 +258,8 @@ def collision_weights(medium, floats, grid, layer, density, weight):
 def bottom_weights(grid, floats, ps, p, weight):
     """What a bottom reflection sends at each wavelength, as a local estimate needs it (the
     packet settled on reaching the bottom plane): weight_j = p.w G_j bottom_q_j, times the
-    BRDF the estimate evaluates."""
+    BRDF the estimate evaluates (its finite part: a lambertian_specular bottom's diffuse lobe,
+    whose shares are bottom_q's first row)."""
     n = grid.n_wl
     _, g, _ = weights(grid, ps)
     share = floats[grid.bottom_q:grid.bottom_q + n]
@@ -379,13 +380,16 @@ def attenuate(medium, floats, grid, tally, ps, p, layer, dist):
 
 
 @kernel
-def reflect(grid, floats, tally, ps, p, rho):
+def reflect(grid, floats, tally, ps, p, rho, mirror):
     """The bottom reflects rho (the sampled BRDF's weight, on p.w; 1 after the analog walk's
     reflection draw) times wavelength j's share bottom_q_j of the reflectance (on G_j); the
-    rest is absorbed by the bottom."""
+    rest is absorbed by the bottom. mirror: the BRDF sampled the mirror lobe of a Lambertian +
+    mirror bottom, whose shares are bottom_q's second row (that lobe's reflectance at j over
+    the packed one's; the first row is the diffuse lobe's, and every other bottom's)."""
     n = grid.n_wl
     _, g, _ = weights(grid, ps)
-    share = floats[grid.bottom_q:grid.bottom_q + n]
+    row = grid.bottom_q + (n if mirror else 0)
+    share = floats[row:row + n]
     absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
     w = p.w
     for j in range(n):

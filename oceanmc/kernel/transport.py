@@ -293,8 +293,9 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
     if est.directions_on or est.cap_on:
         local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
                                  ps, work, p, rng)
-    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, uniform(rng),
-                                   uniform(rng))
+    u1 = uniform(rng)
+    u2 = uniform(rng)
+    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2)
     p.ux = ux
     p.uy = uy
     p.uz = uz
@@ -304,9 +305,11 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
             score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)   # (settled on the plane)
             return False
         if grid.n_wl > 1:
-            spectral.reflect(grid, floats, tally, ps, p, 1.0)
+            spectral.reflect(grid, floats, tally, ps, p, 1.0,
+                             brdf.sampled_mirror(bottom.model, bp, u1))
     elif grid.n_wl > 1:
-        spectral.reflect(grid, floats, tally, ps, p, rho)
+        spectral.reflect(grid, floats, tally, ps, p, rho,
+                         brdf.sampled_mirror(bottom.model, bp, u1))
     else:
         score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w * (1.0 - rho))
         p.w *= rho

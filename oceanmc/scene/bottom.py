@@ -12,8 +12,9 @@ from . import brdf_tables
 
 
 def pack(bottom, wavelengths_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(BOTTOM record, its float pool: the BRDF's parameters from offset 0, and (n_wl,) each
-    wavelength's share of the packed BRDF's reflectance: GRID bottom_q)."""
+    """(BOTTOM record, its float pool: the BRDF's parameters from offset 0, and (2, n_wl) each
+    wavelength's share of the packed BRDF's reflectance, row 1 that of a lambertian_specular
+    bottom's mirror lobe: GRID bottom_q)."""
     bottom, shares = kernel_bottom(bottom, wavelengths_nm)
     model, params = brdf_tables.bottom_arrays(bottom)
     rec = record(BOTTOM, model=model,

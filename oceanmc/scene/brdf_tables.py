@@ -227,10 +227,12 @@ def scalars(bottom) -> list[float]:
         return [bottom.diffuse_reflectance, bottom.specular_reflectance]
     if m == "ggx":
         return [bottom.roughness, bottom.n_ratio, bottom.diffuse_reflectance,
-                1.0 if bottom.fresnel else 0.0]
+                1.0 if bottom.fresnel else 0.0, bottom.albedo_scale]
     if m == "hapke":
         return [bottom.albedo, bottom.asymmetry, bottom.opposition_amplitude,
-                bottom.opposition_width]
+                bottom.opposition_width, bottom.albedo_scale]
+    if m == "table":
+        return [0.0, 0.0, 0.0, 0.0, bottom.albedo_scale]   # slot 4: brdf/table.py SCALE
     return []
 
 
@@ -238,6 +240,9 @@ def describe(bottom) -> str:
     name = f"bottom.model = {bottom.model!r}"
     if bottom.model == "table":
         name += f" (file {bottom.file})"
+    if isinstance(getattr(bottom, "albedo_scale", None), float) and bottom.albedo_scale != 1.0:
+        name += (f" at albedo_scale = {bottom.albedo_scale:g} (the largest over the run's "
+                 "wavelengths)")
     return name
 
 

@@ -95,8 +95,9 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
     (a depth profile's sublayers each absorb into a budget column of their own). The row holds
     scores only (the packet's state is the packet's: kernel/packet.py), every score with its
-    wavelengths side by side; bottom_shares: each wavelength's bottom reflectance relative to
-    the packed BRDF's (default 1). The row holds one part of `size` scores per collision
+    wavelengths side by side; bottom_shares: (2, n_wl) each wavelength's bottom reflectance
+    relative to the packed BRDF's (default 1), row 1 for a lambertian_specular bottom's mirror
+    lobe (optics/bottom.py kernel_bottom). The row holds one part of `size` scores per collision
     channel: the elastic light's, then each inelastic process's."""
     grid = make_grid(config.tallies)
     mu = mu_edges(grid.theta_edges)
@@ -127,7 +128,8 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     rec = record(
         GRID, n_wl=n_wl, n_parts=n_parts, scores=shared_size,
         source_q=f.add(source_q),
-        bottom_q=f.add(np.ones(n_wl) if bottom_shares is None else bottom_shares),
+        bottom_q=f.add(np.ones(2 * n_wl) if bottom_shares is None
+                       else np.ravel(bottom_shares)),
         n_depths=n_depths, air_level=n_depths, surface_level=surface_level,
         mu_cut=float(config.tallies.grazing_mu_cut), radiance_on=int(radiance_on),
         n_theta=len(grid.theta), n_phi=int(config.tallies.phi_bands),

@@ -77,6 +77,16 @@ def pdf_local(model, params, wix, wiy, wiz, wox, woy, woz):
 
 
 @kernel
+def sampled_mirror(model, params, u1):
+    """Whether reflect(model, params, ..., u1, u2) takes the mirror lobe of a Lambertian +
+    mirror bottom (whose lobes' shares may differ per wavelength: kernel/spectral.py reflect);
+    False for every other model."""
+    if model == BOTTOM_LAMBERTIAN_SPECULAR:
+        return lambertian_specular.mirror_sampled(params, u1)
+    return False
+
+
+@kernel
 def reflect(model, params, ux, uy, uz, u1, u2):
     """A photon travelling (ux, uy, uz), uz > 0, meets the bottom: returns the reflected travel
     direction (upward) and the weight factor. Local frame = (x, -y, -z) of the global one (a

@@ -3,14 +3,16 @@ masking-shadowing and unpolarized Fresnel reflection at the facets, plus an opti
 term (Walter, Marschner, Li & Torrance 2007, EGSR, "Microfacet models for refraction through
 rough surfaces"; Heitz 2014, JCGT 3(2), "Understanding the masking-shadowing function").
 
-params = (alpha, n_ratio, rho_d, fresnel):
+params = (alpha, n_ratio, rho_d, fresnel, scale):
   alpha    roughness (the GGX width, 0 < alpha <= 1; small: near-mirror)
   n_ratio  refractive index of the facet material relative to the water above it
   rho_d    reflectance of an added Lambertian term (0: pure microfacet reflection)
   fresnel  1: Fresnel reflectance at the facets; 0: F = 1 (perfectly reflecting facets, the
            "white furnace" configuration)
+  scale    the albedo scale: f times it (bottom.albedo_scale, the largest over the run's
+           wavelengths; kernel/spectral.py gives each wavelength its share)
 
-f = F(wi.h) D(h) G2(wi, wo) / (4 cos t_i cos t_o) + rho_d/pi, with h = (wi + wo)/|wi + wo|,
+f = scale [F(wi.h) D(h) G2(wi, wo) / (4 cos t_i cos t_o) + rho_d/pi], with h = (wi + wo)/|wi + wo|,
 D(h) = alpha^2 / (pi ((h.n)^2 (alpha^2 - 1) + 1)^2),
 G2 = 1/(1 + Lambda(wi) + Lambda(wo)), Lambda(v) = (sqrt(1 + alpha^2 tan^2 t_v) - 1)/2.
 f is symmetric in wi and wo (reciprocal) and non-negative; single-scattering microfacet
@@ -22,13 +24,15 @@ JCGT 7(4), "Sampling the GGX distribution of visible normals"), reflected about 
 normal, whose density is G1(wi) D(h) / (4 cos t_i); otherwise a cosine-weighted direction.
 q_s = 1 without a Lambertian term, else max(0.2, F(t_i)/(F(t_i) + rho_d)). The weight is
 f cos t_o / pdf with pdf the mixture density (one-sample multiple importance sampling), which for
-pure microfacet reflection is F G2 / G1(wi) <= 1. A reflected direction below the horizon has
-f = 0: it comes back as (0, 0, 1) with weight 0."""
+pure microfacet reflection is scale F G2 / G1(wi) (<= 1 at scale <= 1). A reflected direction
+below the horizon has f = 0: it comes back as (0, 0, 1) with weight 0."""
 import math
 
 from ..compile import kernel
 from ..geometry import from_angles
 from ..surface.fresnel import fresnel as fresnel_r
+
+SCALE = 4   # params slot of the albedo scale
 
 
 @kernel
@@ -85,7 +89,8 @@ def specular(params, wix, wiy, wiz, wox, woy, woz):
 def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     if wiz <= 0.0 or woz <= 0.0:
         return 0.0
-    return specular(params, wix, wiy, wiz, wox, woy, woz) + params[2] / math.pi
+    f = specular(params, wix, wiy, wiz, wox, woy, woz) + params[2] / math.pi
+    return f * params[SCALE]
 
 
 @kernel

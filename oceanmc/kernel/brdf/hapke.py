@@ -2,10 +2,12 @@
 (retroreflective) model used for soils and sediments (Hapke 1981, J. Geophys. Res. 86, 3039;
 Hapke 1993, Theory of Reflectance and Emittance Spectroscopy, Eqs. 8.89 and 8.81-8.83).
 
-params = (w, xi, B0, h):
+params = (w, xi, B0, h, scale):
   w   single-scattering albedo of the grains (0 < w <= 1)
   xi  Henyey-Greenstein asymmetry of the grains in Hapke's sign convention (xi < 0: backward)
   B0  amplitude of the opposition surge, h its angular width (rad-like, ~0.01-0.2)
+  scale  the albedo scale: f times it (bottom.albedo_scale; kernel/spectral.py gives each
+         wavelength its share)
 
 With mu0 = cos t_i, mu = cos t_o and the phase angle g (cos g = wi . wo: g = 0 when the light
 goes straight back towards the source, the hot spot):
@@ -22,6 +24,8 @@ tabulated sampler (general.py) samples it."""
 import math
 
 from ..compile import kernel
+
+SCALE = 4   # params slot of the albedo scale
 
 
 @kernel
@@ -50,4 +54,4 @@ def evaluate(params, wix, wiy, wiz, wox, woy, woz):
     gamma = math.sqrt(max(0.0, 1.0 - w))
     r0 = (1.0 - gamma) / (1.0 + gamma)
     multiple = chandrasekhar_h(w, r0, wiz) * chandrasekhar_h(w, r0, woz) - 1.0
-    return w / (4.0 * math.pi) / (wiz + woz) * ((1.0 + b) * p + multiple)
+    return w / (4.0 * math.pi) / (wiz + woz) * ((1.0 + b) * p + multiple) * params[SCALE]

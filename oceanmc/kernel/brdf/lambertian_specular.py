@@ -16,6 +16,14 @@ from . import lambertian
 
 
 @kernel
+def mirror_sampled(params, u1):
+    """Whether sample(params, ..., u1, u2) takes the mirror lobe (the spectral walk then gives
+    each wavelength its mirror part's share: kernel/spectral.py reflect)."""
+    total = params[0] + params[1]
+    return total > 0.0 and u1 < params[1] / total
+
+
+@kernel
 def sample(params, wix, wiy, wiz, u1, u2):
     rho_d = params[0]
     rho_s = params[1]

@@ -11,6 +11,9 @@ the mirror direction. An isotropic table has n_pi = 1. A symmetric table covers 
 f(-dphi) = f(dphi); otherwise the nodes run from 0 to 2 pi (the 2 pi column a copy of the 0 one,
 added when the table is packed), and so do the phi_i nodes of an anisotropic table.
 
+params[4] is the albedo scale: f times it (bottom.albedo_scale; kernel/spectral.py gives each
+wavelength its share).
+
 f is multilinear in (theta_i, phi_i, theta_r, dphi) between the nodes and constant beyond the
 first and last theta nodes (tables rarely reach grazing angles)."""
 import math
@@ -20,6 +23,7 @@ from ..models import BRDF_TABLE_AT
 from ..search import interval
 
 HEADER = 8
+SCALE = 4   # params slot of the albedo scale
 
 
 @kernel
@@ -82,4 +86,4 @@ def evaluate(params, wix, wiy, wiz, wox, woy, woz):
                 v0 = params[val_at + base]
                 v1 = params[val_at + base + 1] if fc > 0.0 else 0.0
                 total += wa * wb * wr * ((1.0 - fc) * v0 + fc * v1)
-    return total
+    return total * params[SCALE]
