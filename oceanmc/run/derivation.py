@@ -32,7 +32,7 @@ class RunFacts:
     directions: list            # local_directions_deg: (theta, phi) of the exact directions
     local_rows: list            # each direction's (water row, air row) in the tally `local`
     nadir_local: bool           # the nadir cap's local estimate gives Lu, Lw_nadir, Rrs_nadir
-    sun: tuple[float, float]    # (zenith in deg, direct Ed(0+)): the beam taken out of rho
+    sun_zenith_deg: float       # where the sun's beam falls, taken out of the sky in rho
     parts: tuple[str, ...]      # the parts of the tally row: elastic, then each inelastic process
     wavelengths: np.ndarray     # (n_wl,) nm
     ed0: np.ndarray             # (n_wl,) Ed(0+) at each wavelength (the illumination spectrum)
@@ -52,7 +52,7 @@ class RunFacts:
             config_layer=np.array([layer.config_layer for layer in sc.layers], dtype=np.int64),
             radiance=config.tallies.radiance, directions=config.tallies.local_directions_deg,
             local_rows=sc.local_rows, nadir_local=config.nadir_local,
-            sun=(light.sun_zenith_deg, light.Ed0 * (1.0 - light.diffuse_fraction)),
+            sun_zenith_deg=light.sun_zenith_deg,
             parts=("elastic",) + (tuple(name for name, _ in inelastic.processes())
                                   if inelastic is not None else ()),
             wavelengths=config.wavelengths, ed0=ed0, diffuse=diffuse)
@@ -83,10 +83,9 @@ def run_result(views: list[dict[str, np.ndarray]], done: int, facts: RunFacts, a
         whole = {name: sum(part[name] for part in parts) for name in parts[0]}
         if reflected is not None:
             parts[0]["reflected_local"] = whole["reflected_local"] = reflected[k]
-        ed0 = float(facts.ed0[k])
-        result = from_tallies(whole, facts, ed0, attrs)
+        result = from_tallies(whole, facts, k, attrs)
         if facts.inelastic:
-            add_parts(result, {name: from_tallies(part, facts, ed0, attrs)
+            add_parts(result, {name: from_tallies(part, facts, k, attrs)
                                for name, part in zip(facts.parts, parts)})
         per_wavelength.append(result)
     return per_wavelength[0] if len(views) == 1 else \
@@ -152,18 +151,23 @@ LU_LOCAL = "polar-cap quad average (theta 175-180 deg with HydroLight edges), lo
            "Lu_crossing, air/Lw_nadir_crossing, air/Rrs_nadir_crossing"
 
 
-def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, ed0: float, attrs: dict) -> Result:
-    """Normalises one wavelength's raw per-batch weight sums (per launched photon, times its
-    Ed(0+) `ed0`; radiances also per quad solid angle) and derives the contract's quantities:
+def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
+                 attrs: dict) -> Result:
+    """Normalises the raw per-batch weight sums of wavelength index `wavelength` (per launched
+    photon, times its Ed(0+); radiances also per quad solid angle) and derives the contract's
+    quantities:
     the irradiances, the radiances on the quads (facts.radiance), Lu, Lw_nadir and Rrs_nadir
     from the local polar-cap estimate in raw["cap"] (facts.nadir_local), the exact directions'
     local estimates in raw["local"] and their surface-reflected radiance in
     raw["reflected_local"], and the budget. attrs: the run's, with Lu_method added."""
+    ed0 = float(facts.ed0[wavelength])
     scale = ed0 / facts.photons_per_batch
     q = Quantities()
     add_irradiances(q, raw["flux"], facts.depths, scale)
     if facts.radiance:
-        add_radiances(q, raw["radiance"], facts, scale, ed0)
+        # the sun's direct Ed(0+) at this wavelength (a spectrum's own diffuse share)
+        direct = ed0 * (1.0 - float(facts.diffuse[wavelength]))
+        add_radiances(q, raw["radiance"], facts, scale, ed0, direct)
     if facts.nadir_local:
         add_nadir_local(q, raw["cap"] * scale, len(facts.depths), ed0)
     if len(facts.directions):
@@ -217,10 +221,11 @@ def add_irradiances(q: Quantities, raw_flux: np.ndarray, depths: np.ndarray,
 
 
 def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scale: float,
-                  ed0: float) -> None:
+                  ed0: float, direct: float) -> None:
     """The radiance on the (theta, phi) quads at the tally depths and at 0+ (all light, the
-    water-leaving light, the surface-reflected light and its reflectance factor rho), and the
-    nadir quantities from their polar cap (crossing estimates)."""
+    water-leaving light, the surface-reflected light and its reflectance factor rho, whose sky
+    radiance leaves out the sun's direct Ed(0+) `direct` at this wavelength), and the nadir
+    quantities from their polar cap (crossing estimates)."""
     grid, n_depths = facts.grid, len(facts.depths)
     omega = grid.solid_angle
     rad = raw_radiance * scale / omega
@@ -247,10 +252,10 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
     edges = grid.theta_edges
     if np.allclose(edges, 180.0 - edges[::-1]):
         sky_down = air_rad[:, ::-1].copy()
-        theta_s, e_direct = facts.sun
+        theta_s = facts.sun_zenith_deg
         i = min(int(np.searchsorted(edges, theta_s, side="right")) - 1, len(edges) - 2)
         j = 0 if grid.is_cap[i] else int(np.searchsorted(grid.phi_edges, 0.0, "right")) - 1
-        beam = e_direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
+        beam = direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
         mirror = len(edges) - 2 - i
         sky_down[:, mirror, j] -= beam
         if grid.is_cap[i]:
