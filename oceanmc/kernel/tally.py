@@ -1,6 +1,6 @@
 """Plane-crossing tallies, the one crossing scorer: a photon of weight w crossing a level with
 direction cosine mu adds w to Ed or Eu, w/|mu| to Eod or Eou and to the radiance of its quad
-(normalised by the quad's solid angle and the photon count later, in run/results.py). Grazing
+(normalised by the quad's solid angle and the photon count later, in run/derivation.py). Grazing
 crossings use the surface-flux rule: 1/|mu| is replaced by 2/mu_cut when |mu| < mu_cut, which is
 exact when the radiance is constant over |mu| < mu_cut and keeps the variance finite (MCNP
 manual, F2 surface flux tally).

@@ -15,4 +15,4 @@ Energy: the budget has a column for the weight a process takes from a wavelength
 wavelength's budget closes in every part of the tally row (the elastic light's and each
 process's): reflected + water-leaving + absorbed + bottom + lost + truncated + shifted out -
 shifted in = the part's source (1 for the elastic part, 0 for an inelastic one)
-(run/results.py budget_terms)."""
+(run/derivation.py budget_terms)."""
