@@ -78,12 +78,15 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
     return ed0, diffuse, zenith
 
 
-def monochromatic_illumination(config: cfg.SceneConfig) -> cfg.Illumination:
+def monochromatic_illumination(config: cfg.SceneConfig,
+                               spectrum: tuple[np.ndarray, np.ndarray] | None = None
+                               ) -> cfg.Illumination:
     """The illumination of a one-wavelength scene as the flat one the packers take (Ed0 and
-    diffuse_fraction of its spectrum at that wavelength)."""
+    diffuse_fraction of its spectrum at that wavelength; spectrum: illumination_spectrum's
+    first two, if already computed)."""
     light = config.illumination
     if light.spectrum.model == "flat":
         return light
-    ed0, diffuse, _ = illumination_spectrum(config)
+    ed0, diffuse = spectrum if spectrum is not None else illumination_spectrum(config)[:2]
     return light.model_copy(update={"Ed0": float(ed0[0]), "diffuse_fraction": float(diffuse[0]),
                                     "spectrum": cfg.FlatSpectrum(model="flat")})

@@ -134,9 +134,9 @@ def prepare(config: SceneConfig) -> PreparedRun:
     """Packs a validated scene and computes its illumination spectrum, once. Raises
     ConfigError (one line) for unusable auxiliary files or tallies too large for memory."""
     data_hashes = data_file_hashes(config)   # before the build reads them
-    sc = scene.build(config)
-    check_tally_memory(config, sc)
     ed0, diffuse, _ = illumination_spectrum(config)
+    sc = scene.build(config, (ed0, diffuse))
+    check_tally_memory(config, sc)
     return PreparedRun(config, sc, RunFacts.of(config, sc, ed0, diffuse),
                        config_to_yaml(config, (ed0, diffuse)), data_hashes)
 

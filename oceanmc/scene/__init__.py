@@ -65,19 +65,24 @@ def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
                   emission_weight=float(est.emission_weight))
 
 
-def build(config: cfg.SceneConfig) -> Scene:
-    """The kernel's view of a validated scene. Raises TableError (a ConfigError) for unusable
-    auxiliary files."""
-    med, mf, mi, column = medium.pack(config)
+def build(config: cfg.SceneConfig,
+          illumination: tuple[np.ndarray, np.ndarray] | None = None) -> Scene:
+    """The kernel's view of a validated scene; illumination: its (Ed0, diffuse fraction) per
+    wavelength (optics.illumination_spectrum), computed here if not given. Raises TableError
+    (a ConfigError) for unusable auxiliary files."""
+    ed0, diffuse = illumination if illumination is not None else \
+        optics.illumination_spectrum(config)[:2]
+    med, mf, mi, column = medium.pack(config, ed0)
     surf = surface.pack(config.surface, config.n_water)
     bot, bp, bottom_shares = bottom.pack(config.bottom, config.wavelengths)
-    sk, sf = sky.pack(optics.monochromatic_illumination(config))
+    sk, sf = sky.pack(optics.monochromatic_illumination(config, (ed0, diffuse)))
     # the sky's share of the photons: the wavelengths' mean diffuse fraction (grid.source_q
     # gives each wavelength its own)
-    sk[0]["diffuse_fraction"] = grid.stratified_fraction(optics.illumination_spectrum(config)[1])
+    sk[0]["diffuse_fraction"] = grid.stratified_fraction(diffuse)
     *directions, local_rows = estimates.local_directions(config, surf)
     gr, gf, gi, angles = grid.pack(config, column.depths, column.level_tau, column.surface_level,
-                                   len(directions[0]), len(column.albedo), bottom_shares)
+                                   len(directions[0]), len(column.albedo), diffuse,
+                                   bottom_shares)
     est, ef, ei = estimates.pack(config, med, mf, mi, surf, column, angles, tuple(directions))
     no_ints = np.zeros(0, dtype=np.int64)
     (med, bot, sk, gr, est, surf), floats, ints = merge(

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
-from .. import optics
 from ..kernel import models
 from ..kernel.records import GRID, Pool, record
 
@@ -88,10 +87,11 @@ def source_shares(diffuse_fraction: np.ndarray) -> np.ndarray:
 
 
 def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
-         surface_level: int, n_dirs: int, n_layers: int,
+         surface_level: int, n_dirs: int, n_layers: int, diffuse: np.ndarray,
          bottom_shares: np.ndarray | None = None
          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Grid]:
-    """(GRID record, float pool, int pool, Grid). Tally levels: the depths, then 0+ (all
+    """(GRID record, float pool, int pool, Grid); diffuse: the illumination's diffuse share
+    per wavelength (optics.illumination_spectrum). Tally levels: the depths, then 0+ (all
     light), then 0+ (water-leaving light); n_dirs local-estimate rows; n_layers the medium's
     (a depth profile's sublayers each absorb into a budget column of their own). The row holds
     scores only (the packet's state is the packet's: kernel/packet.py), every score with its
@@ -120,7 +120,6 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
     # or a settle adds to all wavelengths of a score at once, a few cache lines instead of one
     # per wavelength
     size = shared_size + n_wl * (size - shared_size)
-    _, diffuse, _ = optics.illumination_spectrum(config)
     source_q = source_shares(diffuse)
     f, i = Pool(np.float64), Pool(np.int64)
     inelastic = config.water.inelastic

@@ -179,13 +179,15 @@ def _emits(transfer: np.ndarray) -> list[int]:
     return [int(lit[0]), int(lit[-1]) + 1] if len(lit) else [0, 0]
 
 
-def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
+def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Column]:
     """(MEDIUM record, float pool, int pool, Column). Per-layer optics are layer-major, n_wl
     values per layer; optical depths wavelength-major (the local estimates read them); the
     Column's albedo is the largest of each layer's wavelengths' (it caps the upward bias, which
     a spectral walk applies at every wavelength: kernel/upward.py). Collision channels
     (kernel/channels/): elastic scattering, which takes all of b, then the inelastic processes
-    of water.inelastic (optics/inelastic/)."""
+    of water.inelastic (optics/inelastic/), whose transfer needs the illumination's Ed0 per
+    wavelength (computed here if not given)."""
     layers = optics.column_iops(config)
     n_wl = len(config.wavelengths)
     if n_wl > 1:
@@ -263,7 +265,9 @@ def pack(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray, C
     up_cos = math.cos(cone)
     up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
 
-    inelastic = optics.inelastic.channels(config, layers, optics.illumination_spectrum(config)[0])
+    if ed0 is None:
+        ed0 = optics.illumination_spectrum(config)[0]
+    inelastic = optics.inelastic.channels(config, layers, ed0)
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
         MEDIUM, n_planes=len(plane_z), n_layers=len(layers), n_wl=n_wl,
