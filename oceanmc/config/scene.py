@@ -38,9 +38,11 @@ class SceneConfig(_Strict):
     tallies: Tallies = Field(default_factory=Tallies)
     estimator: Estimator = Field(default_factory=Estimator)
     wavelengths_nm: Wavelengths | None = None
-    # the wavelengths the validator added to wavelengths_nm for the excitation of inelastic
-    # light (config/inelastic.py transport_grid); the run's summary names them
-    _added_wavelengths: list[float] = PrivateAttr(default_factory=list)
+    # the grid a run with inelastic light traces (config/inelastic.py transport_grid: the
+    # requested wavelengths_nm and those the excitation needs), set by the validator; the
+    # config keeps (and a stored config writes) the requested grid, so that loading it again
+    # gives the same traced grid. None: the requested grid is traced
+    _traced: list[float] | None = PrivateAttr(default=None)
 
     @field_validator("wavelengths_nm")
     @classmethod
@@ -136,9 +138,9 @@ class SceneConfig(_Strict):
         return self
 
     def _extend_for_inelastic(self, spectral: bool) -> None:
-        """With inelastic light, wavelengths_nm becomes the traced grid (transport_grid),
-        or a one-line refusal naming the wavelengths needed where per-wavelength lists were
-        given for the requested grid only."""
+        """With inelastic light, the traced grid (transport_grid; `wavelengths`), or a
+        one-line refusal naming the wavelengths needed where per-wavelength lists were given
+        for the requested grid only."""
         inelastic = self.water.inelastic
         if inelastic is None or not inelastic.processes():
             return
@@ -146,7 +148,7 @@ class SceneConfig(_Strict):
         if not spectral:
             raise ValueError(f"{names} moves light between wavelengths: it needs "
                              "wavelengths_nm (a list in nm, or {start, stop, step})")
-        requested = self.wavelengths
+        requested = grid(self.wavelengths_nm)
         traced = transport_grid(requested, inelastic)
         if len(traced) == len(requested):
             return
@@ -159,13 +161,15 @@ class SceneConfig(_Strict):
                 f"{names} needs the light of {_listed(added)} nm, which wavelengths_nm "
                 f"lacks; add them to wavelengths_nm and give the per-wavelength lists values "
                 f"there ({exc})") from None
-        self.wavelengths_nm = [float(w) for w in traced]
-        self._added_wavelengths = added
+        self._traced = [float(w) for w in traced]
 
     @property
     def added_wavelengths(self) -> list[float]:
         """The wavelengths (nm) added to the requested grid for inelastic light."""
-        return list(self._added_wavelengths)
+        if self._traced is None:
+            return []
+        requested = grid(self.wavelengths_nm)
+        return [w for w in self._traced if not np.isclose(requested, w).any()]
 
     @property
     def nadir_local(self) -> bool:
@@ -181,7 +185,10 @@ class SceneConfig(_Strict):
 
     @property
     def wavelengths(self):
-        """The wavelength grid (nm, numpy array); [nan] for a monochromatic scene."""
+        """The wavelength grid the run traces (nm, numpy array): wavelengths_nm, with what
+        inelastic light's excitation needs; [nan] for a monochromatic scene."""
+        if self._traced is not None:
+            return np.array(self._traced)
         return grid(self.wavelengths_nm)
 
     @property
