@@ -29,8 +29,8 @@ PROCESSES = {"raman": {}, "chlorophyll_fluorescence": {}}
 # (label, water.inelastic, estimator.emission_weight)
 RUNS = (("elastic only", None, None),
         ("inelastic, defaults", PROCESSES, None),
-        ("inelastic, emission_weight 0.003", PROCESSES, 0.003),
-        ("inelastic, emission_weight 0.03", PROCESSES, 0.03))
+        ("inelastic, emission_weight 0.001", PROCESSES, 0.001),
+        ("inelastic, emission_weight 0.01", PROCESSES, 0.01))
 # (label, quantity, wavelength)
 ROWS = (("Rrs(550)", "air/Rrs_nadir", 550.0),
         ("elastic Rrs(550)", "elastic/air/Rrs_nadir", 550.0),

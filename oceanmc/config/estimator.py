@@ -11,7 +11,7 @@ from .base import _Strict
 # auto's upward fraction in spectral scenes: the Rrs nadir of a 31-band windy Case-1 scene to 1%
 # in 20-30 s where it took 1,000-10,000 s without it (benchmarks/real_scenes.md)
 AUTO_UPWARD_FRACTION = 0.1
-DEFAULT_EMISSION_WEIGHT = 0.01
+DEFAULT_EMISSION_WEIGHT = 0.003
 
 
 class Estimator(_Strict):
