@@ -26,22 +26,12 @@ from oceanmc import scene
 from oceanmc.config import ConfigError, config_to_yaml, data_file_hashes, load_config
 from oceanmc.optics.bottom import kernel_bottom
 
+from bottom_helpers import WAVELENGTHS, scene_dict
 from stats_helpers import assert_z
 
-WAVELENGTHS = [440.0, 550.0, 670.0]
-WATER = {"layers": [{"thickness_m": 2.0, "a": 0.05, "b": 0.1}]}
 GGX = {"model": "ggx", "roughness": 0.4, "fresnel": False}
 HAPKE = {"model": "hapke", "albedo": 0.6}
 SCALE = [0.4, 1.0, 0.7]
-
-
-def scene_dict(bottom, wavelengths=WAVELENGTHS, **changes):
-    out = {"photons": 400, "batches": 2, "seed": 5, "water": copy.deepcopy(WATER),
-           "bottom": bottom, "tallies": {"depths_m": [0, 2]}}
-    if wavelengths is not None:
-        out["wavelengths_nm"] = wavelengths
-    out.update(changes)
-    return out
 
 
 def refused(config, *words, build=False):
