@@ -130,6 +130,16 @@ def _callable(fn, default: float):
     return lambda lam: np.broadcast_to(np.asarray(fn(lam), dtype=np.float64), np.shape(lam))
 
 
+def _source_and_attenuation(absorption, irradiance, b488: float, exponent: float):
+    """E0(l') and c(l) = a(l) + b_R(l) of the analytic calculations (no elastic scattering)."""
+    a_fn = _callable(absorption, 0.0)
+
+    def c_fn(x):
+        return a_fn(x) + raman_b(x, b488, exponent)
+
+    return _callable(irradiance, 1.0), c_fn
+
+
 # --- analytic single scattering ------------------------------------------------------------------
 
 
@@ -202,11 +212,7 @@ def single_scattering(wavelengths_nm, depth_m, absorption, *, b488: float = B488
     """
     lam = np.atleast_1d(np.asarray(wavelengths_nm, dtype=np.float64))
     d = float(depth_m)
-    a_fn = _callable(absorption, 0.0)
-    e0_fn = _callable(irradiance, 1.0)
-
-    def c_fn(x):
-        return a_fn(x) + raman_b(x, b488, exponent)
+    e0_fn, c_fn = _source_and_attenuation(absorption, irradiance, b488, exponent)
 
     mu, wmu = _mu_quadrature(mu_nodes, mu_cut)
     pw = 2.0 * math.pi * wmu * raman_phase(mu, beta)        # 2 pi p(mu) dmu (p is even in cos)
@@ -247,11 +253,7 @@ def second_order_bound(wavelengths_nm, depth_m, absorption, *, b488: float = B48
     """
     lam = np.atleast_1d(np.asarray(wavelengths_nm, dtype=np.float64))
     d = float(depth_m)
-    a_fn = _callable(absorption, 0.0)
-    e0_fn = _callable(irradiance, 1.0)
-
-    def c_fn(x):
-        return a_fn(x) + raman_b(x, b488, exponent)
+    e0_fn, c_fn = _source_and_attenuation(absorption, irradiance, b488, exponent)
 
     def line_grid(l, step):               # excitation wavelengths that feed emission l
         lo, hi = 1e7 / (1e7 / l + DK_MAX), 1e7 / (1e7 / l + DK_MIN)
