@@ -110,6 +110,34 @@ def test_regular_grid_with_raman_adds_340_to_390():
     assert plain.added_wavelengths == []
 
 
+def test_a_stored_config_loads_to_the_same_traced_grid():
+    """The config keeps the requested wavelengths; the traced grid follows from them, so a
+    config dumped or written as YAML (a results file's, a checkpoint's) and loaded again
+    traces the same grid, not one extended again for the added wavelengths' own excitation
+    (it once was: 290 nm, outside SPECTRL2)."""
+    import yaml
+    from oceanmc.config import config_to_yaml
+    config = oceanmc.load_config(scene())
+    assert config.wavelengths_nm.start == 400.0
+    for again in (oceanmc.load_config(config.model_dump()),
+                  oceanmc.load_config(yaml.safe_load(config_to_yaml(config))),
+                  config.model_copy(update={"photons": 64})):
+        np.testing.assert_array_equal(again.wavelengths, config.wavelengths)
+        assert again.added_wavelengths == ADDED
+
+
+def test_the_analog_walk_closes_every_part_exactly():
+    """The analog walk (absorption drawn; emissions still expected values) closes each part's
+    budget to rounding: elastic 1, inelastic 0."""
+    config = scene({"raman": {"b488_per_m": 2.6e-3}, "chlorophyll_fluorescence": {}})
+    config["photons"] = 8000
+    config["estimator"] = {"mode": "analog", "upward_fraction": None}
+    result = oceanmc.simulate(config, threads=2)
+    for part, source in zip(PARTS, (1.0, 0.0, 0.0)):
+        np.testing.assert_allclose(result[f"{part}/budget/total"], source, rtol=0, atol=1e-9)
+    assert result["raman/budget/shifted_in"].max() > 0.0
+
+
 def test_raman_shift_range_holds_walrafen_lines():
     # outside RAMAN_SHIFT_RANGE (where the grid stops extending) lies less than 1e-6 of
     # Walrafen's density (the photons a grid that stops there loses), and its value there is
