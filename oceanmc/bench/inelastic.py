@@ -14,14 +14,13 @@ the inelastic parts (whose time adds the elastic run's). Writes DIR/inelastic.md
 DIR/inelastic.json (`oceanmc bench --inelastic`)."""
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
 import numpy as np
 
 from ..run.simulation import simulate
-from .report import kernel_commit
+from .report import run_section
 
 BATCHES = 64
 TARGET_REL = 0.01
@@ -98,17 +97,11 @@ def measure(quick: bool, say) -> dict:
 
 
 def main(out_dir: Path, quick: bool) -> int:
-    data = measure(quick, lambda text: print(text, flush=True))
-    data["quick"] = quick
-    write(out_dir, data, kernel_commit())
-    print(f"wrote {out_dir / 'inelastic.md'}")
-    return 0
+    return run_section(out_dir, "inelastic", quick, measure, report_lines)
 
 
-def write(out_dir: Path, data: dict, commit: str) -> None:
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "inelastic.json").write_text(json.dumps({**data, "kernel_commit": commit},
-                                                       indent=1))
+def report_lines(data: dict, commit: str) -> list[str]:
+    """The section's report (DIR/inelastic.md)."""
     runs = {run["run"]: run for run in data["runs"]}
     elastic, default = runs["elastic only"], runs["inelastic, defaults"]
     lines = ["# oceanmc benchmark: inelastic light (issue 27)", "",
@@ -145,4 +138,4 @@ def write(out_dir: Path, data: dict, commit: str) -> None:
         f"the inelastic parts is {separate:.2f}x the separate way's; its elastic part "
         f"reaches 1% in {default['rows']['elastic Rrs(550)']['time_to_target_s']:,.1f} s "
         f"against the elastic run's {own:,.1f} s.", ""]
-    (out_dir / "inelastic.md").write_text("\n".join(lines))
+    return lines

@@ -12,7 +12,6 @@ time and worst band are reported. Writes DIR/real_scenes.md and DIR/real_scenes.
 (`oceanmc bench --real-scenes`)."""
 from __future__ import annotations
 
-import json
 import math
 import time
 from pathlib import Path
@@ -20,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..run.simulation import simulate
-from .report import kernel_commit
+from .report import run_section
 
 WAVELENGTHS = {"start": 400.0, "stop": 700.0, "step": 10.0}
 QUANTITY = "air/Rrs_nadir"
@@ -103,17 +102,11 @@ def measure(quick: bool, say) -> dict:
 
 
 def main(out_dir: Path, quick: bool) -> int:
-    data = measure(quick, lambda text: print(text, flush=True))
-    data["quick"] = quick
-    write(out_dir, data, kernel_commit())
-    print(f"wrote {out_dir / 'real_scenes.md'}")
-    return 0
+    return run_section(out_dir, "real_scenes", quick, measure, report_lines)
 
 
-def write(out_dir: Path, data: dict, kernel_commit: str) -> None:
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "real_scenes.json").write_text(json.dumps({**data, "kernel_commit":
-                                                          kernel_commit}, indent=1))
+def report_lines(data: dict, kernel_commit: str) -> list[str]:
+    """The section's report (DIR/real_scenes.md)."""
     lines = ["# oceanmc benchmark: real scenes (issue 26)", "",
              "Regenerate with `oceanmc bench --real-scenes -o benchmarks`"
              + (" (--quick: small counts)" if data.get("quick") else "") + ". "
@@ -145,4 +138,4 @@ def write(out_dir: Path, data: dict, kernel_commit: str) -> None:
     lines += ["", f"The headline scene (Chl 0.3, deep) with the defaults and "
               f"{t['photons']:,} photons: {t['time_s']:.1f} s, worst band {t['worst_nm']:g} nm "
               f"at {100 * t['worst_rel']:.2f}% (target: every band <= 1% in <= 60 s).", ""]
-    (out_dir / "real_scenes.md").write_text("\n".join(lines))
+    return lines

@@ -255,6 +255,21 @@ def sampling_ratios(foms: list[dict]) -> list[dict]:
     return out
 
 
+def run_section(out_dir: Path, name: str, quick: bool, measure, lines) -> int:
+    """A section of `oceanmc bench` on its own (--real-scenes, --inelastic): measure(quick,
+    say) gives its data; DIR/name.json holds them with the kernel commit they measured,
+    DIR/name.md the report lines(data, commit)."""
+    data = measure(quick, lambda text: print(text, flush=True))
+    data["quick"] = quick
+    commit = kernel_commit()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / f"{name}.json").write_text(json.dumps({**data, "kernel_commit": commit},
+                                                      indent=1))
+    (out_dir / f"{name}.md").write_text("\n".join(lines(data, commit)))
+    print(f"wrote {out_dir / (name + '.md')}")
+    return 0
+
+
 def kernel_commit() -> str:
     """The last commit that changed the compiled kernel (oceanmc/kernel/), with '+' when the
     working tree changes it too, for a report to say what it measured; 'unknown' outside a
