@@ -46,12 +46,15 @@ REQUESTED = np.arange(400.0, 701.0, 10.0)
 ADDED = [340.0, 350.0, 360.0, 370.0, 380.0, 390.0]
 
 
-def scene(inelastic=BOTH, seed=SEED, extra_absorption=None) -> dict:
+def scene(inelastic=BOTH, seed=SEED, extra_absorption=None, emitted_light=None) -> dict:
     """Chl 0.05 Case-1 water, deep, sun at 30 deg, flat sea, 400-700 nm every 10 nm
-    (validation/cases/inelastic.py clear_water), 30k photons in 32 batches."""
+    (validation/cases/inelastic.py clear_water), 30k photons in 32 batches; emitted_light:
+    estimator.emitted_light (default: carried)."""
     inelastic = copy.deepcopy(inelastic)
     config = clear_water("inelastic test", PHOTONS, inelastic, seed, extra_absorption)
     config["batches"] = BATCHES
+    if emitted_light is not None:
+        config["estimator"] = {"emitted_light": emitted_light}
     return config
 
 
@@ -382,6 +385,12 @@ def whole():
 
 
 @pytest.fixture(scope="module")
+def packets():
+    """The same scene with each emission in a packet of its own (the reference estimator)."""
+    return oceanmc.simulate(scene(BOTH, emitted_light="packets"))
+
+
+@pytest.fixture(scope="module")
 def elastic_only(whole):
     """The same scene without inelastic light, its Raman loss as a constant absorber, on the
     first run's traced grid, same seed."""
@@ -485,21 +494,53 @@ def test_emission_equals_take_times_transfer_in_expectation(whole):
 
 # --- 4. the elastic part = the run without inelastic light ------------------------------------
 
-def test_elastic_part_equals_run_without_inelastic_light(whole, elastic_only):
+def test_elastic_part_equals_run_without_inelastic_light(packets, elastic_only):
+    """With emitted packets the elastic walk makes the draws of the run without inelastic
+    light (the emissions draw from a stream of their own): equal batch by batch."""
     np.testing.assert_allclose(np.asarray(elastic_only.coords["wavelength"]),
-                               np.asarray(whole.coords["wavelength"]))
+                               np.asarray(packets.coords["wavelength"]))
     assert "budget/shifted_out" not in elastic_only
     for name in ("Ed", "Eu", "Lu", "air/Rrs_nadir", "Eo", "budget/water_leaving"):
-        np.testing.assert_allclose(whole.quantities[f"elastic/{name}"].batches,
+        np.testing.assert_allclose(packets.quantities[f"elastic/{name}"].batches,
                                    elastic_only.quantities[name].batches, rtol=1e-9,
                                    atol=1e-300, err_msg=name)
-    taken = (whole.quantities["elastic/budget/absorbed_layer_1"].batches
-             + whole.quantities["elastic/budget/shifted_out"].batches)
+    taken = (packets.quantities["elastic/budget/absorbed_layer_1"].batches
+             + packets.quantities["elastic/budget/shifted_out"].batches)
     np.testing.assert_allclose(taken, elastic_only.quantities["budget/absorbed_layer_1"].batches,
                                rtol=1e-9, atol=1e-15)
     # the inelastic light is extra: the whole exceeds the elastic run at 550 nm
-    k = int(np.argmin(np.abs(np.asarray(whole.coords["wavelength"]) - 550.0)))
-    assert whole["air/Rrs_nadir"][k] > elastic_only["air/Rrs_nadir"][k]
+    k = int(np.argmin(np.abs(np.asarray(packets.coords["wavelength"]) - 550.0)))
+    assert packets["air/Rrs_nadir"][k] > elastic_only["air/Rrs_nadir"][k]
+
+
+def test_carried_elastic_part_matches_run_without_inelastic_light(whole, elastic_only):
+    """Where the emitting packet carries the light on (the default), roulette weighs all the
+    light a packet carries, so the draws part from the run without inelastic light: the
+    elastic part agrees within |z| < Z_MAX at every wavelength and depth."""
+    worst = 0.0
+    for name in ("Ed", "Eu", "Lu", "air/Rrs_nadir", "Eo", "budget/water_leaving"):
+        z = z_of(whole[f"elastic/{name}"] - elastic_only[name],
+                 np.hypot(whole.stderr(f"elastic/{name}"), elastic_only.stderr(name)), 0.0)
+        worst = max(worst, float(np.abs(z).max()))
+        assert (np.abs(z) < Z_MAX).all(), (name, z)
+    print("carried elastic part vs run without inelastic light, max |z|:", worst)
+
+
+def test_carried_light_agrees_with_emitted_packets(whole, packets):
+    """Two estimators of each inelastic part, independent draws: the light carried on by the
+    emitting packet, and a packet of its own per emission; |z| < Z_MAX wherever the part is
+    lit (above 1e-3 of its largest value)."""
+    worst = {}
+    for part in ("raman", "chlorophyll_fluorescence"):
+        for name in ("air/Rrs_nadir", "Ed", "Eu", "Eou", "budget/shifted_in"):
+            quantity = f"{part}/{name}"
+            reference = packets[quantity]
+            lit = np.abs(reference) > 1e-3 * np.abs(reference).max()
+            z = z_of(whole[quantity] - reference,
+                     np.hypot(whole.stderr(quantity), packets.stderr(quantity)), 0.0)[lit]
+            worst[quantity] = float(np.abs(z).max())
+            assert (np.abs(z) < Z_MAX).all(), (quantity, z)
+    print("carried vs emitted packets, max |z|:", worst)
 
 
 # --- 5. the HDF5 round trip ---------------------------------------------------------------------

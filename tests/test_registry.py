@@ -141,7 +141,8 @@ def test_channel_registry_and_dispatch():
         medium, mf, mi, ctrl, grid, packet, ps, work, tally = arrays
         p = packet[0]
         p.w, p.ux, p.uy, p.uz = 1.0, 0.0, 0.0, 1.0
-        channels.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, rng)
+        channels.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, False,
+                         rng)
         return p.w, p.uz
 
     sc = scene.build(oceanmc.load_config({
@@ -163,7 +164,7 @@ def test_channel_registry_and_dispatch():
         spectral.collision_density(medium[0], floats, grid[0], ps, p, 0,
                                    work[:grid[0].n_wl])
         return channels.emit(medium[0], surface[0], ctrl[0], grid[0], est[0], floats, ints,
-                             tally, work, stack, stack_ps, 0, p, ps, 0, rng)
+                             tally, work, stack, stack_ps, 0, p, ps, 0, False, rng)
 
     inelastic = {"raman": {"b488_per_m": 0.05}, "chlorophyll_fluorescence": {}}
     sc = scene.build(oceanmc.load_config({
@@ -177,14 +178,16 @@ def test_channel_registry_and_dispatch():
                          ("elastic", "raman", "chlorophyll_fluorescence")]
     n = int(sc.grid[0]["n_wl"])
     packet = np.zeros(1, dtype=records.PACKET)
-    ps = np.zeros(records.packet_state_size(n))
+    parts = int(sc.grid[0]["n_parts"])
+    ps = np.zeros(records.packet_state_size(n, parts))
     ps[:n] = 1.0               # K
     ps[n:2 * n] = 1.0 / n      # G
+    ps[3 * n + 1:4 * n + 1] = 1.0   # all of its light elastic (packet.shares)
     stack = np.zeros(4, dtype=records.PACKET)
-    stack_ps = np.zeros((4, records.packet_state_size(n)))
+    stack_ps = np.zeros((4, records.packet_state_size(n, parts)))
     tally = np.zeros(sc.tally_size)
     height = emit((sc.medium, sc.surface, sc.estimator, sc.grid, sc.estimates, sc.floats,
-                   sc.ints, packet), ps, stack, stack_ps, np.zeros(records.work_size(n)), tally,
+                   sc.ints, packet), ps, stack, stack_ps, np.zeros(records.work_size(n, parts)), tally,
                   batch_state(3, 1))
     assert height == 2 and list(stack["part"][:2]) == [1, 2]
     size = int(sc.grid[0]["part_size"])

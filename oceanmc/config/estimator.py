@@ -36,9 +36,15 @@ class Estimator(_Strict):
     # at least 0.01 deg: the kernel draws cos psi = 1 - u (1 - cos A), whose 1 - cos A is
     # accurate to 1e-8 relative there and loses all accuracy near 1e-6 deg
     upward_cone_deg: Annotated[float, Field(ge=0.01, le=90.0, allow_inf_nan=False)] = 15.0
-    # the least weight of a packet that an inelastic process (water.inelastic) emits; lighter
+    # the light an inelastic process (water.inelastic) emits at a collision: `carried` on by
+    # the packet that emitted it (its weight times the emission's phase function over the
+    # density of the packet's new direction), or each emission in a `packets` of its own (the
+    # reference the carried light is checked against: validation case inelastic). The default
+    # measured best for the inelastic parts of Rrs (benchmarks/inelastic.md)
+    emitted_light: Literal["carried", "packets"] = "carried"
+    # the least weight of an emitted packet (emitted_light packets, the analog walk); lighter
     # emissions are made with probability weight / emission_weight and carry emission_weight
-    # (kernel/channels/inelastic.py). The default measured best for the Raman part of Rrs in
-    # clear water (benchmarks/inelastic.md)
+    # (kernel/channels/inelastic.py); measured best for packets in clear water
+    # (benchmarks/inelastic.md)
     emission_weight: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = \
         DEFAULT_EMISSION_WEIGHT

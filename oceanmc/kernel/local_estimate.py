@@ -33,10 +33,12 @@ from . import spectral
 from .brdf import dispatch as brdf
 from .compile import internal, kernel
 from .geometry import from_angles
+from .packet import weights
 from .phase import dispatch as phase
 from .phase import quadratic
 from .rng import uniform
 from .surface import dispatch as surface_bsdf
+from .tally import deposit
 
 
 # below this transmission (at mu = 1, the least attenuated wavelength) to the nearest level
@@ -80,21 +82,23 @@ def layer_phase(medium, floats, ints, grid, layer, cos_psi, out):
 
 
 @internal
-def add_to_levels(est, floats, ints, grid, tally, z, tau_here, k, base, mu, j):
+def add_to_levels(est, floats, ints, grid, tally, share, z, tau_here, k, base, mu, j):
     """Row k scores the in-water levels above z (if it is an in-water row) and/or 0+ (factor
-    t/n^2; 0 if it is not scored there), at wavelength index j."""
+    t/n^2; 0 if it is not scored there), at wavelength index j (split by the parts' shares
+    `share`: tally.deposit)."""
     n = grid.n_wl
     row = est.n_dirs * n     # one level's scores: direction-major, wavelength fastest
-    local = grid.local + k * n + j
+    local = grid.local + k * n
     taus = grid.level_tau + j * grid.n_depths
     if ints[est.in_water + k]:
         for level in range(grid.n_depths):
             if floats[grid.level_z + level] <= z:
-                tally[local + level * row] += base * math.exp(
-                    -(tau_here - floats[taus + level]) / mu)
+                deposit(grid, tally, share, local + level * row, j, base * math.exp(
+                    -(tau_here - floats[taus + level]) / mu))
     factor = floats[est.air_factor + k]
     if factor > 0.0:
-        tally[local + grid.n_depths * row] += base * math.exp(-tau_here / mu) * factor
+        deposit(grid, tally, share, local + grid.n_depths * row, j,
+                base * math.exp(-tau_here / mu) * factor)
 
 
 @internal
@@ -137,8 +141,8 @@ def into_water_through_rough(surface, est, floats, k, rng):
 
 
 @internal
-def cap_from_collision(est, floats, grid, tally, above, tau_here, w_scattered, m0w, m1w, m0a,
-                       m1a, j):
+def cap_from_collision(est, floats, grid, tally, share, above, tau_here, w_scattered, m0w, m1w,
+                       m0a, m1a, j):
     """The polar-cap average of the nadir-viewing radiance that a collision sends to the
     `above` levels above it and to 0+, at wavelength index j (see scene/estimates.py for the
     expansion and its accuracy). The levels are sorted by depth: the transmission to the
@@ -146,7 +150,7 @@ def cap_from_collision(est, floats, grid, tally, above, tau_here, w_scattered, m
     the two levels (level_decay), so the cap costs two exps (water and air) whatever the
     number of levels."""
     n = grid.n_wl
-    cap = grid.cap + j     # level l of wavelength j at cap + l n
+    cap = grid.cap     # level l of wavelength j at cap + l n + j
     taus = grid.level_tau + j * grid.n_depths
     mu = est.mu_w
     if above > 0:
@@ -155,13 +159,13 @@ def cap_from_collision(est, floats, grid, tally, above, tau_here, w_scattered, m
         scale = w_scattered / (mu * est.omega_w)
         for level in range(above - 1, -1, -1):
             dtau = tau_here - floats[taus + level]
-            tally[cap + level * n] += scale * transmitted * (
-                m0w + m1w * (dtau / mu - 1.0) / mu)
+            deposit(grid, tally, share, cap + level * n, j, scale * transmitted * (
+                m0w + m1w * (dtau / mu - 1.0) / mu))
             transmitted *= floats[decay + level]
     mu = est.mu_a
     e = math.exp(-tau_here / mu)
-    tally[cap + grid.n_depths * n] += w_scattered * e * (
-        m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a
+    deposit(grid, tally, share, cap + grid.n_depths * n, j, w_scattered * e * (
+        m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a)
 
 
 @internal
@@ -173,6 +177,7 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
     0+), and the polar-cap average of the nadir-viewing radiance, at every wavelength."""
     n = grid.n_wl
     weight, tau, phase_j = scratch(grid, work)
+    share = weights(grid, ps)[3]
     if n == 1:
         weight[0] = w_scattered
     else:
@@ -192,22 +197,23 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
                                 phase_j)
                     at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
-                        tally[at + j] += (
-                            weight[j] * phase_j[j] * t * math.exp(tau[j] / iz) / -iz * factor)
+                        deposit(grid, tally, share, at, j, weight[j] * phase_j[j] * t * math.exp(
+                            tau[j] / iz) / -iz * factor)
                 continue
             dx, dy, dz = direction(est, floats, k)
             mu = -dz
             layer_phase(medium, floats, ints, grid, layer, ux * dx + uy * dy + uz * dz, phase_j)
             for j in range(n):
-                add_to_levels(est, floats, ints, grid, tally, z, tau[j], k,
+                add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k,
                               weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
-        cap_scores(est, grid, floats, ints, tally, weight, tau, z, uz,
+        cap_scores(est, grid, floats, ints, tally, share, weight, tau, z, uz,
                    ints[est.table_of_layer + layer], 0, n, rng)
 
 
 @internal
-def cap_scores(est, grid, floats, ints, tally, weight, tau, z, uz, table, first, last, rng):
+def cap_scores(est, grid, floats, ints, tally, share, weight, tau, z, uz, table, first, last,
+               rng):
     """The polar-cap averages (to the levels above depth z and to 0+) of what a point of
     scattering sends up, for a packet travelling with direction cosine uz, from the cap tables
     `table` (a layer's phase function, or an inelastic emission's) at the wavelengths
@@ -243,8 +249,8 @@ def cap_scores(est, grid, floats, ints, tally, weight, tau, z, uz, table, first,
         scale = CAP_ROULETTE / kept
     for j in range(first, last):
         m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
-        cap_from_collision(est, floats, grid, tally, above, tau[j], weight[j] * scale, m0w,
-                           m1w, m0a, m1a, j)
+        cap_from_collision(est, floats, grid, tally, share, above, tau[j], weight[j] * scale,
+                           m0w, m1w, m0a, m1a, j)
 
 
 @internal
@@ -274,7 +280,7 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
         spectral.bottom_weights(grid, floats, ps, p, weight)
     for j in range(n):
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
-    from_point(est, grid, surface, floats, ints, bp, tally, weight, tau,
+    from_point(est, grid, surface, floats, ints, bp, tally, weights(grid, ps)[3], weight, tau,
                floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng)
 
 
@@ -285,23 +291,24 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
     work[2 n:3 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
     beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
     directions (directions_from_point) and the polar-cap averages (cap_scores, as a
-    collision's), scored in the emission's part of the tally row `tally`."""
+    collision's), scored in the emission's part of the tally row, where `tally` starts."""
     n = grid.n_wl
     weight = work[2 * n:3 * n]
     tau = work[3 * n:4 * n]
+    one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
     for j in range(first, last):
         tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
     if est.directions_on:
-        directions_from_point(est, grid, surface, floats, ints, floats, tally, weight, tau,
-                              p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
+        directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
+                              tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
     if est.cap_on:
-        cap_scores(est, grid, floats, ints, tally, weight, tau, p.z, p.uz, table, first, last,
-                   rng)
+        cap_scores(est, grid, floats, ints, tally, one_part, weight, tau, p.z, p.uz, table,
+                   first, last, rng)
 
 
 @internal
-def directions_from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, uy,
-                          uz, model, beta_at, first, last, rng):
+def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z,
+                          ux, uy, uz, model, beta_at, first, last, rng):
     """The radiance a point source at depth z (optical depths tau, weights `weight` at the
     wavelengths first .. last - 1, none elsewhere; toward() says what it sends, a bottom's
     BRDF or an emission's phase function) sends in the exact directions."""
@@ -315,19 +322,19 @@ def directions_from_point(est, grid, surface, floats, ints, bp, tally, weight, t
                 f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
                 at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                 for j in range(first, last):
-                    tally[at + j] += (
-                        weight[j] * f * t * math.exp(tau[j] / iz) * factor)
+                    deposit(grid, tally, share, at, j,
+                            weight[j] * f * t * math.exp(tau[j] / iz) * factor)
             continue
         dx, dy, dz = direction(est, floats, k)
         f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
         for j in range(first, last):
-            add_to_levels(est, floats, ints, grid, tally, z, tau[j], k, weight[j] * f, -dz,
-                          j)
+            add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k, weight[j] * f,
+                          -dz, j)
 
 
 @internal
-def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, uy, uz, model,
-               rng):
+def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z, ux, uy, uz,
+               model, rng):
     """The radiance the bottom (BRDF `model`) at depth z sends in the exact directions
     (directions_from_point), and the polar-cap average from one direction W drawn uniformly in
     the cap (an unbiased estimate of the cap average; f is bounded for every non-mirror BRDF),
@@ -335,8 +342,8 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
     n = grid.n_wl
     first, last = 0, n
     if est.directions_on:
-        directions_from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux,
-                              uy, uz, model, 0, first, last, rng)
+        directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau,
+                              z, ux, uy, uz, model, 0, first, last, rng)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
@@ -345,8 +352,8 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
             taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
                 if floats[grid.level_z + level] <= z:
-                    tally[grid.cap + level * n + j] += weight[j] * f * math.exp(
-                        -(tau[j] - floats[taus + level]) / mu)
+                    deposit(grid, tally, share, grid.cap + level * n, j, weight[j] * f * math.exp(
+                        -(tau[j] - floats[taus + level]) / mu))
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
         if surface.delta == 0:
@@ -358,8 +365,8 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
                 f = toward(model, bp, floats, 0, ux, uy, uz, ix, iy, iz) * t / (
                     n_water * n_water)
                 for j in range(first, last):
-                    tally[grid.cap + grid.n_depths * n + j] += (
-                        weight[j] * f * math.exp(tau[j] / iz))
+                    deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
+                            weight[j] * f * math.exp(tau[j] / iz))
             return
         sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n_water
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
@@ -368,5 +375,5 @@ def from_point(est, grid, surface, floats, ints, bp, tally, weight, tau, z, ux, 
         f = toward(model, bp, floats, 0, ux, uy, uz, sin_w * math.cos(phi),
                    sin_w * math.sin(phi), -mu_w)
         for j in range(first, last):
-            tally[grid.cap + grid.n_depths * n + j] += (
-                weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))
+            deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
+                    weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

@@ -151,10 +151,11 @@ ESTIMATES = _record(
 
 # How weights evolve (kernel/transport.py).
 # emission_weight: the least weight of a packet an inelastic process emits (lighter emissions
-# play roulette up to it: kernel/channels/inelastic.py)
+# play roulette up to it); carry_emissions: the packet that emits light carries it on
+# (kernel/channels/inelastic.py)
 ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",
-                    "split_weight", "splitting", "upward", "emission_weight",
-                    ints=("analog", "max_events", "splitting", "upward"))
+                    "split_weight", "splitting", "upward", "emission_weight", "carry_emissions",
+                    ints=("analog", "max_events", "splitting", "upward", "carry_emissions"))
 
 # A photon packet: position (depth z and the segment it is in or on), weight, direction of
 # travel, whether it still belongs to the collimated solar beam, its wavelength's index (in
@@ -168,20 +169,24 @@ PACKET = _record("z", "w", "ux", "uy", "uz", "seg", "beam", "wavelength", "refer
 SPLIT_STACK_ROWS = 64
 
 
-def packet_state_size(n_wl: int) -> int:
+def packet_state_size(n_wl: int, n_parts: int = 1) -> int:
     """Floats of a packet's spectral state (kernel/spectral.py state: K, G and F at the last
-    settle, n_wl each, then the free path D since it); one wavelength keeps none, but the row
-    is never empty."""
-    return 3 * n_wl + 1 if n_wl > 1 else 1
+    settle, n_wl each, then the free path D since it; with inelastic processes, n_parts > 1,
+    then each part's share of the packet's light at each wavelength, n_parts x n_wl:
+    kernel/packet.py); one wavelength keeps none, but the row is never empty."""
+    if n_wl == 1:
+        return 1
+    return 3 * n_wl + 1 + (n_parts * n_wl if n_parts > 1 else 0)
 
 
-def work_size(n_wl: int) -> int:
+def work_size(n_wl: int, n_parts: int = 1) -> int:
     """Floats of one event's scratch: a collision's volume scattering function at every
     wavelength (kernel/spectral.py), then a local estimate's weight, optical depth and phase
     function at every wavelength (kernel/local_estimate.py). An inelastic emission's weights
-    per unit coefficient, what it takes and what it emits use the first three of these rows
-    (kernel/channels/inelastic.py)."""
-    return 4 * n_wl
+    per unit coefficient, what it takes and what it emits use the first three of these rows;
+    what each inelastic process emits at a collision waits in one more row each until the
+    packet that carries it has turned (kernel/channels/inelastic.py)."""
+    return (4 + max(0, n_parts - 1)) * n_wl
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

@@ -70,8 +70,8 @@ from .models import BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, PHASE_TABUL
 from .phase import dispatch as phase
 from .phase import tabulated
 from .rng import uniform
-from .packet import free_path_at, weights
-from .tally import spectral_at
+from .packet import belong_to, free_path_at, weights
+from .tally import deposit, spectral_at
 
 # a K_j past this, or positive below its inverse, settles the packet (its exponentials bring
 # the K back near 1), long before products of ratios could overflow or underflow; a K_j still
@@ -90,7 +90,7 @@ def start(grid, floats, ps, p, from_sky, rng):
     """A new photon: its wavelengths' shares of the source (sun or sky: grid.source_q) and its
     hero wavelength, drawn uniformly (the reference wavelength starts as the hero)."""
     n = grid.n_wl
-    k, g, last = weights(grid, ps)
+    k, g, last, _ = weights(grid, ps)
     row = grid.source_q + (n if from_sky else 0)
     share = floats[row:row + n]
     for j in range(n):
@@ -98,6 +98,7 @@ def start(grid, floats, ps, p, from_sky, rng):
         g[j] = share[j]
         last[j] = 0.0
     ps[free_path_at(grid)] = 0.0
+    belong_to(grid, ps, 0)
     p.wavelength = min(n - 1, int(uniform(rng) * n))
     p.reference = p.wavelength
 
@@ -106,7 +107,7 @@ def start(grid, floats, ps, p, from_sky, rng):
 def carry(grid, ps, p):
     """The packet's weights as they are now are what it carries on in its layer (it has just
     entered the water, or been reflected by the surface or the bottom)."""
-    _, g, last = weights(grid, ps)
+    _, g, last, _ = weights(grid, ps)
     w = p.w
     for j in range(grid.n_wl):
         last[j] = w * g[j]
@@ -131,7 +132,7 @@ def settle(medium, floats, grid, tally, ps, p, layer):
     mean 1 and G to G_r = 1 (so p.w is F_r, and p.w G_j is F_j), and adds to the layer's
     absorption what each wavelength lost since the last settle."""
     n = grid.n_wl
-    k, g, last = weights(grid, ps)
+    k, g, last, share = weights(grid, ps)
     dist = ps[free_path_at(grid)]
     row = medium.layer_c + layer * n
     c = floats[row:row + n]
@@ -161,7 +162,7 @@ def settle(medium, floats, grid, tally, ps, p, layer):
         k[j] = k_j if k_j >= K_FLOOR else 0.0
         g[j] *= g_norm
         now = w * g[j]
-        tally[absorbed + j] += last[j] - now
+        deposit(grid, tally, share, absorbed, j, last[j] - now)
         last[j] = now
 
 
@@ -227,7 +228,7 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     factor c_k (its collision density), so weight_j = p.w s G_j e_j / mean_k(K_k e_k c_k) (the
     mean of K e cancels; one wavelength: w / c, the implicit-capture weight per unit b)."""
     n = grid.n_wl
-    k, g, _ = weights(grid, ps)
+    k, g, _, _ = weights(grid, ps)
     row = medium.layer_c + layer * n
     c = floats[row:row + n]
     dist = ps[free_path_at(grid)]
@@ -240,6 +241,43 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     scale = p.w * math.exp((c[p.reference] - c_h) * dist) * n / total
     for j in range(n):
         weight[j] *= scale * g[j]
+
+
+@kernel
+def hero_posterior(medium, floats, grid, ps, layer, out):
+    """At a collision of a settled packet: the probability that each wavelength is the hero,
+    given the path so far (its density K_j with the collision point's c_j, over their sum),
+    into out (n_wl). Averaged over it, the hero's direction density is the density of the
+    direction the walk draws next (direction_density)."""
+    n = grid.n_wl
+    k, _, _, _ = weights(grid, ps)
+    row = medium.layer_c + layer * n
+    c = floats[row:row + n]
+    total = 0.0
+    for j in range(n):
+        out[j] = k[j] * c[j]
+        total += out[j]
+    per_total = 1.0 / total
+    for j in range(n):
+        out[j] *= per_total
+
+
+@kernel
+def direction_density(medium, floats, grid, posterior, beta, layer, angle, keep, cone_density):
+    """The density (1/sr) with which the walk drew its new direction, turned by `angle` from
+    the incident one, averaged over the hero's posterior: sum_j posterior_j (keep p_j + d),
+    p_j = beta_j / (2 pi sin(psi) b_j) from the volume scattering function the collision just
+    read (beta, volume_scattering's units, at the same clamped angle), d the upward cone's
+    density (0 outside it)."""
+    n = grid.n_wl
+    row = layer * n
+    c_over_b = floats[medium.layer_c_over_b + row:medium.layer_c_over_b + row + n]
+    inv_c = floats[medium.layer_inv_c + row:medium.layer_inv_c + row + n]
+    total = 0.0
+    for j in range(n):
+        total += posterior[j] * beta[j] * c_over_b[j] * inv_c[j]
+    clamped = min(math.pi - tabulated.EDGE, max(tabulated.EDGE, angle))
+    return keep * total / (2.0 * math.pi * math.sin(clamped)) + cone_density
 
 
 @kernel
@@ -261,7 +299,7 @@ def bottom_weights(grid, floats, ps, p, weight):
     BRDF the estimate evaluates (its finite part: a lambertian_specular bottom's diffuse lobe,
     whose shares are bottom_q's first row)."""
     n = grid.n_wl
-    _, g, _ = weights(grid, ps)
+    _, g, _, _ = weights(grid, ps)
     share = floats[grid.bottom_q:grid.bottom_q + n]
     w = p.w
     for j in range(n):
@@ -297,7 +335,7 @@ def scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s
     at 5 standard errors on Rrs, validation spectral_history.)"""
     h = p.wavelength
     n = grid.n_wl
-    k, g, _ = weights(grid, ps)
+    k, g, _, _ = weights(grid, ps)
     beta = work[:n]
     volume_scattering(medium, floats, ints, layer, cos_s, angle, psi_s, node_s, beta)
     row = medium.layer_c_over_b + layer * n
@@ -351,10 +389,10 @@ def scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s
 def lose(grid, tally, ps, layer):
     """The packet lost roulette, or the analog walk's absorption draw, in `layer`: what it
     carried at its last settle stays there (every collision since then was in that layer)."""
-    _, _, last = weights(grid, ps)
+    _, _, last, share = weights(grid, ps)
     absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(grid.n_wl):
-        tally[absorbed + j] += last[j]
+        deposit(grid, tally, share, absorbed, j, last[j])
 
 
 @kernel
@@ -363,7 +401,7 @@ def attenuate(medium, floats, grid, tally, ps, p, layer, dist):
     settle books the rest as absorbed); dist = inf (down an infinitely deep layer): all of it
     is absorbed there, or lost below where c_j = 0. Returns whether the packet is gone."""
     n = grid.n_wl
-    _, g, _ = weights(grid, ps)
+    _, g, _, share = weights(grid, ps)
     row = medium.layer_c + layer * n
     c = floats[row:row + n]
     if dist < math.inf:
@@ -375,7 +413,7 @@ def attenuate(medium, floats, grid, tally, ps, p, layer, dist):
     lost = spectral_at(grid, grid.budget + BUDGET_LOST_BELOW)
     w = p.w
     for j in range(n):
-        tally[(absorbed if c[j] > 0.0 else lost) + j] += w * g[j]
+        deposit(grid, tally, share, absorbed if c[j] > 0.0 else lost, j, w * g[j])
     return True
 
 
@@ -387,13 +425,13 @@ def reflect(grid, floats, tally, ps, p, rho, mirror):
     mirror bottom, whose shares are bottom_q's second row (that lobe's reflectance at j over
     the packed one's; the first row is the diffuse lobe's, and every other bottom's)."""
     n = grid.n_wl
-    _, g, _ = weights(grid, ps)
+    _, g, _, parts = weights(grid, ps)
     row = grid.bottom_q + (n if mirror else 0)
     share = floats[row:row + n]
     absorbed = spectral_at(grid, grid.budget + BUDGET_BOTTOM)
     w = p.w
     for j in range(n):
-        tally[absorbed + j] += w * g[j] * (1.0 - rho * share[j])
+        deposit(grid, tally, parts, absorbed, j, w * g[j] * (1.0 - rho * share[j]))
         g[j] *= share[j]
     p.w *= rho
     carry(grid, ps, p)
@@ -413,7 +451,7 @@ def survives_roulette(medium, floats, ctrl, grid, tally, ps, p, layer, rng):
         return True
     settle(medium, floats, grid, tally, ps, p, layer)
     n = grid.n_wl
-    _, g, _ = weights(grid, ps)
+    _, g, _, _ = weights(grid, ps)
     top = 0.0
     for j in range(n):
         if g[j] > top:

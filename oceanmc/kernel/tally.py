@@ -12,10 +12,13 @@ light only).
 
 Spectral scenes (kernel/spectral.py) hold every score with its wavelengths side by side
 (spectral_at); score() adds a packet's weight to each wavelength, times the wavelength's share q
-of it."""
+of it. With inelastic processes the row holds one copy of every score per part (the elastic
+light's, then each process's); a packet's light at a wavelength may be of several parts at
+once (kernel/packet.py shares), and every spectral scorer adds it through deposit(), which
+splits it by the parts' shares."""
 import math
 
-from .compile import hot, kernel
+from .compile import hot, internal, kernel
 from .models import FLUX_ED, FLUX_EOD, FLUX_EOU, FLUX_EU
 from .search import interval
 from .packet import weights
@@ -106,6 +109,21 @@ def spectral_at(grid, index):
     return grid.scores + (index - grid.scores) * grid.n_wl
 
 
+@internal
+def deposit(grid, tally, share, at, j, value):
+    """Adds `value`, light of wavelength j, to the score whose wavelength-j element is at `at`
+    in the first part of the row `tally`: all of it there when `share` is empty (light of one
+    part: `tally` starts at that part), else each part's share of it (share[part * n_wl + j],
+    packet.shares) to that part's copy of the score."""
+    if share.shape[0] == 0:
+        tally[at + j] += value
+        return
+    n = grid.n_wl
+    size = grid.part_size
+    for part in range(grid.n_parts):
+        tally[part * size + at + j] += value * share[part * n + j]
+
+
 @hot
 def score(grid, tally, ps, index, w):
     """Adds weight w to score `index` (its offset in one wavelength's layout), and in a
@@ -114,10 +132,10 @@ def score(grid, tally, ps, index, w):
     if grid.n_wl == 1:
         tally[index] += w
         return
-    _, q, _ = weights(grid, ps)
+    _, q, _, share = weights(grid, ps)
     at = spectral_at(grid, index)
     for j in range(grid.n_wl):
-        tally[at + j] += w * q[j]
+        deposit(grid, tally, share, at, j, w * q[j])
 
 
 @kernel
@@ -140,14 +158,13 @@ def score_crossing(grid, floats, ints, tally, ps, level, w, ux, uy, uz, beam):
         if quad >= 0:
             tally[quad] += w_over_mu
         return
-    _, q, _ = weights(grid, ps)
+    _, q, _, share = weights(grid, ps)
     plane = spectral_at(grid, plane)
     scalar = spectral_at(grid, scalar)
     for j in range(grid.n_wl):
-        share = q[j]
-        tally[plane + j] += w * share
-        tally[scalar + j] += w_over_mu * share
+        deposit(grid, tally, share, plane, j, w * q[j])
+        deposit(grid, tally, share, scalar, j, w_over_mu * q[j])
     if quad >= 0:
         quad = spectral_at(grid, quad)
         for j in range(grid.n_wl):
-            tally[quad + j] += w_over_mu * q[j]
+            deposit(grid, tally, share, quad, j, w_over_mu * q[j])

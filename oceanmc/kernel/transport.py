@@ -195,15 +195,21 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
 
 
 @internal
-def collide(medium, surface, ctrl, grid, est, floats, ints, tally, tally_row, ps, work, stack,
-            stack_ps, n_stacked, p, layer, events, rng, rng_emitted):
+def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, stack, stack_ps,
+            n_stacked, p, layer, events, rng, rng_emitted):
     """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
-    channels/: they take their share of every wavelength and push packets of their own on the
-    stack), absorption (implicit: weight times the albedo), elastic scattering, roulette.
-    tally: the packet's part of the tally row tally_row. Returns (alive, optical depth to the
-    next collision, stack height)."""
+    channels/: they take their share of every wavelength and emit it, light the packet carries
+    on or that waits on the stack in packets of its own), absorption (implicit: weight times
+    the albedo), elastic scattering, roulette. tally: the batch's tally row, every part of it.
+    Returns (alive, optical depth to the next collision, stack height)."""
     albedo = floats[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
     estimates = (est.directions_on or est.cap_on) and albedo > 0.0
+    # the packet carries its collisions' emissions on where it goes on with its weight
+    # (channels/inelastic.py); settled first, so that the hero's posterior is exact
+    carrying = (medium.n_channels > 1 and ctrl.carry_emissions != 0 and not ctrl.analog
+                and albedo > 0.0)
+    if carrying:
+        spectral.settle(medium, floats, grid, tally, ps, p, layer)
     if grid.n_wl > 1 and (estimates or medium.n_channels > 1):
         # the collision's weight per unit coefficient at every wavelength, which the local
         # estimates (times b) and the inelastic channels (times theirs) read
@@ -211,8 +217,11 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, tally_row, ps
     if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
-    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work,
-                              stack, stack_ps, n_stacked, p, ps, layer, rng_emitted)
+    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
+                              stack, stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted)
+    if carrying:
+        spectral.hero_posterior(medium, floats, grid, ps, layer,
+                                work[grid.n_wl:2 * grid.n_wl])
     w = p.w
     budget = grid.budget
     if ctrl.analog:
@@ -230,7 +239,12 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, tally_row, ps
         if grid.n_wl == 1:  # a spectral walk books absorption when it settles (spectral.py)
             score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w - scattered)
         p.w = scattered
-    channels.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
+    ux, uy, uz = p.ux, p.uy, p.uz
+    density = channels.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer,
+                               carrying, rng)
+    if carrying:
+        channels.carry(medium, grid, floats, tally, work, ps, p, layer,
+                       ux * p.ux + uy * p.uy + uz * p.uz, density)
     p.beam = 0
     tau = exponential(rng)
     if grid.n_wl > 1:
@@ -369,7 +383,8 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
     split copies and the packets its inelastic processes emit (channels/inelastic.py) wait on
     the stack and are traced before the next photon. The tally row holds one part per
     collision channel, each grid.part_size long: the elastic light's, then each process's (a
-    packet scores in its part, p.part). The records come as one-row
+    packet's light may be of several parts, packet.shares; every scorer splits what it scores
+    by them, tally.deposit). The records come as one-row
     arrays, the scene's tables as one float pool and one int pool (kernel/records.py); the GIL
     is released, so batches run in parallel threads."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
@@ -411,7 +426,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         else:
             ux, uy, uz, w = sx, sy, sz, w_sun_in
         packet.launch(p, w, ux, uy, uz, not from_sky)
-        tally = tally_row[:grid.part_size]
+        tally = tally_row
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
@@ -438,7 +453,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
                     alive, tau, n_stacked = collide(medium, surface, ctrl, grid, est, floats,
-                                                    ints, tally, tally_row, ps, work, stack,
+                                                    ints, tally, ps, work, stack,
                                                     stack_ps, n_stacked, p, where, walk_events,
                                                     draws, rng_emitted)
                 elif outcome == FLIGHT_PLANE:
@@ -460,7 +475,6 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                 break
             n_stacked -= 1
             packet.copy(grid, p, ps, stack[n_stacked], stack_ps[n_stacked])
-            # an emitted packet scores in its process's part and draws from the second stream
-            tally = tally_row[p.part * grid.part_size:(p.part + 1) * grid.part_size]
+            # an emitted packet draws from the second stream
             draws = rng if p.part == 0 else rng_emitted
     return n_photons, events

@@ -166,8 +166,10 @@ class Batches:
         self.packets = np.zeros((n, PACKET_STRIDE), dtype=PACKET)
         self.stacks = np.zeros((n, sc.stack_rows), dtype=PACKET)
         n_wl = len(config.wavelengths)
-        self.states = np.zeros((n, sc.stack_rows + 1, row_floats(packet_state_size(n_wl))))
-        self.work = np.zeros((n, row_floats(work_size(n_wl))))
+        n_parts = int(sc.grid[0]["n_parts"])
+        self.states = np.zeros((n, sc.stack_rows + 1,
+                                row_floats(packet_state_size(n_wl, n_parts))))
+        self.work = np.zeros((n, row_floats(work_size(n_wl, n_parts))))
         self.locks = [threading.Lock() for _ in range(n)]
         self.stopping = threading.Event()
 

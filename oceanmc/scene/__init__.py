@@ -62,7 +62,8 @@ def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
                   split_weight=float(est.split_weight or np.inf),
                   splitting=int(est.split_weight is not None),
                   upward=int(upward.max(initial=0.0) > 0.0),
-                  emission_weight=float(est.emission_weight))
+                  emission_weight=float(est.emission_weight),
+                  carry_emissions=int(est.emitted_light == "carried"))
 
 
 def build(config: cfg.SceneConfig,

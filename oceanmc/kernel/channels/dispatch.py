@@ -5,23 +5,32 @@ from . import elastic, inelastic
 
 
 @internal
-def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng):
     """The elastic channel, every scene's (scene/medium.py packs it first as channel 0): the
-    packet's new direction and weights."""
-    elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng)
+    packet's new direction and weights; returns the density the direction was drawn with
+    when the packet carries emissions (elastic.scatter)."""
+    return elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer,
+                           carrying, rng)
 
 
 @internal
 def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack, stack_ps,
-         n_stacked, p, ps, layer, rng_emitted):
+         n_stacked, p, ps, layer, carrying, rng_emitted):
     """Every inelastic channel (1 .. n_channels - 1; their models: MEDIUM channel_model, all
     run by channels/inelastic.py) of a collision of packet p, before its implicit capture;
     work[:n_wl] holds the collision's weight per unit coefficient at every wavelength
-    (spectral.collision_density). Returns the new stack height."""
+    (spectral.collision_density). carrying: the packet carries the emissions on (carry), else
+    each starts a packet of its own. Returns the new stack height."""
     if medium.n_channels == 1:
         return n_stacked
     for channel in range(1, medium.n_channels):
         n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
                                    tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,
-                                   rng_emitted)
+                                   carrying, rng_emitted)
     return n_stacked
+
+
+@internal
+def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density):
+    """The collision's emissions ride on in packet p (inelastic.carry)."""
+    inelastic.carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)

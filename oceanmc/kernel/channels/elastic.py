@@ -12,8 +12,11 @@ from ..rng import uniform
 
 
 @internal
-def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
-    """The packet's new direction, and its weights for it (see channels/__init__.py)."""
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng):
+    """The packet's new direction, and its weights for it (see channels/__init__.py).
+    carrying: the packet carries a collision's emissions on (channels/inelastic.py carry),
+    and work[n_wl:2 n_wl] holds the hero's posterior (spectral.hero_posterior); returns the
+    density with which the direction was drawn, averaged over it (1/sr; else 0)."""
     ux, uy, uz = p.ux, p.uy, p.uz
     h = p.wavelength
     spectral_walk = grid.n_wl > 1
@@ -34,6 +37,7 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
             cos_s = phase.sample_cos(medium, floats, ints, layer, h, u_pick, uniform(rng))
             angle = 0.0
         nx, ny, nz = turn(ux, uy, uz, cos_s, uniform(rng))
+    density = 0.0
     if spectral_walk:
         keep = 1.0
         cone_density = 0.0
@@ -43,8 +47,13 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, rng):
                 cone_density = floats[medium.up_density + layer]
         spectral.scatter_weights(medium, floats, ints, grid, tally, ps, work, p, layer, cos_s,
                                  angle, psi_s, node_s, keep, cone_density, ctrl.analog != 0)
+        if carrying:
+            n = grid.n_wl
+            density = spectral.direction_density(medium, floats, grid, work[n:2 * n],
+                                                 work[:n], layer, angle, keep, cone_density)
     elif ctrl.upward:
         p.w = upward.weight(medium, floats, ints, layer, p.w, ux * nx + uy * ny + uz * nz, nz)
     p.ux = nx
     p.uy = ny
     p.uz = nz
+    return density

@@ -4,45 +4,59 @@ w_j sigma_j (w_j the collision's weight per unit coefficient, spectral.collision
 sigma_j the process's coefficient in the layer), and emits at each wavelength i
 E_i = sum_j x_j T_ji (T the process's transfer: redistribution, photon-to-energy factor
 lambda_j / lambda_i, and the source spectrum's ratio Ed0_j / Ed0_i, since a packet's weight at
-a wavelength is a share of that wavelength's Ed0). The emission starts a packet of its own at
-the collision point (a new source of light, as the sun's photons are: hero wavelength drawn
-anew, in proportion to the emission), in a direction drawn from the process's phase function about the incident
-direction, tallied in the process's part of the tally row (p.part); it waits on the split stack
-and is traced after the packet that emitted it, within the same photon history. The emitting
-packet goes on elastically: the process's loss is in its attenuation (Raman) or absorption
-(fluorescence), and the budget moves x_j from absorbed to shifted out.
+a wavelength is a share of that wavelength's Ed0). The emitting packet goes on elastically: the
+process's loss is in its attenuation (Raman) or absorption (fluorescence), and the budget moves
+x_j from absorbed to shifted out.
 
 The light an emission sends straight up (to the tally levels above and out of the water) is
 scored at every collision by local estimates of the expected emission (local_estimate.
 at_emission), as a collision's elastic light is: in clear water most Raman light leaves
-without scattering again. The emitted packet carries the rest. An emission whose mean weight
-per wavelength is below the estimator's emission_weight is made with probability mean /
-emission_weight and then carries that mean (Russian roulette on the emission, unbiased; Kalos &
-Whitlock, Monte Carlo Methods, 2008, 4.2), so that the emitted packets of a history stay few
-(a packet emitted by an emitted packet weighs about sigma / c of it, so their number falls
-geometrically). The transfer is banded (channel_band), so the emission costs the band's width
-per excitation wavelength, not n. Its draws come from the batch's second stream (rng_emitted), so that the elastic
-light's draws, and with them the elastic part of every output, are those of the same scene
-without the inelastic processes (whose loss is kept as absorption)."""
+without scattering again.
+
+The rest rides on in the packet that emitted it (carry): the packet turns by its elastic phase
+function, and the emission goes the same way with the weight E_i p_e(psi) / q(psi), p_e the
+emission's phase function and q the density with which the walk drew the new direction. In a
+spectral walk that is the hero's phase mixture averaged over the hero's posterior given the
+path so far (the walk's K_j c_j at the collision, kernel/spectral.py): q(psi) = sum_j K_j c_j
+q_j(psi) / sum_j K_j c_j, so that from there on the emitted light's weight at i takes the
+same factors as the packet's elastic light at i (the one-sample MIS weight of the rest of the
+path; its ratio to the weight at the collision is unbiased for light that starts there, given
+the path). The packet's state keeps each part's share of its light (packet.shares), and
+every scorer splits what it scores by them (tally.deposit). One walk thus carries every
+emission of a history (the emitted packets it replaces cost 8x the elastic walk's time;
+benchmarks/inelastic.md). Bounded: p_e <= 0.104 1/sr (Raman) and q >= the layer's least
+phase function value, the water's own molecular scattering in every layer.
+
+Where the packet does not go on with its weight (the analog walk, which draws absorption, or
+a layer that only scatters inelastically), the emission starts a packet of its own at the
+collision point (hero wavelength drawn in proportion to the emission), in a direction drawn
+from the process's phase function, tallied in the process's part; it waits on the split stack
+and is traced after the packet that emitted it, within the same photon history. An emission
+whose mean weight per wavelength is below the estimator's emission_weight is made with
+probability mean / emission_weight and then carries that mean (Russian roulette on the
+emission, unbiased; Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2). The transfer is banded
+(channel_band), so the emission costs the band's width per excitation wavelength, not n. The
+emitted packets' draws come from the batch's second stream (rng_emitted)."""
 import math
 
-from .. import local_estimate, packet
+from .. import local_estimate, packet, spectral
 from ..compile import internal
 from ..geometry import turn
 from ..models import BUDGET_LAYERS, BUDGET_SHIFTED_IN, BUDGET_SHIFTED_OUT, BUDGET_TRUNCATED
 from ..phase import quadratic
 from ..rng import uniform
-from ..tally import spectral_at
+from ..tally import deposit, spectral_at
 
 
 @internal
 def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
-         stack_ps, n_stacked, p, ps, layer, rng_emitted):
+         stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted):
     """Channel `channel` (1 ..) of a collision of packet p in `layer`, whose weights per unit
     coefficient are work[:n] (spectral.collision_density): books what it takes from each
-    wavelength in p's part of the tally row, and, when it emits, books what it gives in its
-    own part, scores the local estimates of the emission (local_estimate.at_emission) and
-    pushes the emitted packet on the stack. Returns the new stack height."""
+    wavelength (split by the packet's parts), scores the local estimates of the emission
+    (local_estimate.at_emission), and leaves the emission in the channel's row of the scratch
+    for carry() (carrying: the packet goes on with its weight) or pushes a packet of its own
+    on the stack. Returns the new stack height."""
     n = grid.n_wl
     density = work[:n]
     taken = work[n:2 * n]
@@ -50,28 +64,31 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     sigma_at = medium.channel_sigma + (k * medium.n_layers + layer) * n
     reach_at = medium.channel_reach + k * n
     part_size = grid.part_size
-    own = p.part * part_size
-    absorbed = own + spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
-    out = own + spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT)
+    share = packet.weights(grid, ps)[3]
+    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
+    out = spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT)
     total = 0.0
     for j in range(n):
         x = density[j] * floats[sigma_at + j]
         taken[j] = x
-        tally_row[absorbed + j] -= x
-        tally_row[out + j] += x
+        deposit(grid, tally_row, share, absorbed, j, -x)
+        deposit(grid, tally_row, share, out, j, x)
         total += x * floats[reach_at + j]
+    kept = work[(3 + channel) * n:(4 + channel) * n]   # what carry() adds to the packet
+    for i in range(n):
+        kept[i] = 0.0
     if total <= 0.0:
         return n_stacked
     # roulette on the emitted packet, by its mean weight per wavelength (as p.w is one
     # wavelength's weight): made with probability mean / emission_weight below it
     target = ctrl.emission_weight * n
-    spawn = True
+    spawn = not carrying
     scale = 1.0
-    if total < target:
+    if spawn and total < target:
         spawn = uniform(rng_emitted) * target < total
         scale = target / total
     estimate = est.directions_on or est.cap_on
-    if not (spawn or estimate):
+    if not (spawn or estimate or carrying):
         return n_stacked
     # the emission at each wavelength: T is banded (Raman moves light by 60-120 nm,
     # fluorescence into 685 +- 64 nm), so each excitation row adds to its band only
@@ -96,6 +113,10 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
                                    medium.channel_beta + channel, est.emission_tables + k,
                                    ints[medium.channel_emits + 2 * k],
                                    ints[medium.channel_emits + 2 * k + 1], rng_emitted)
+    if carrying:
+        for i in range(n):
+            kept[i] = emission[i]
+        return n_stacked
     if not spawn:
         return n_stacked
     shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)
@@ -114,7 +135,7 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
         return n_stacked
     child = stack[n_stacked]
     child_ps = stack_ps[n_stacked]
-    k_view, g, last = packet.weights(grid, child_ps)
+    k_view, g, last, _ = packet.weights(grid, child_ps)
     # its hero wavelength drawn in proportion to what it carries (pi_i = E_i / sum E), not
     # uniformly: the one-sample MIS weight becomes f_l / sum_j pi_j p_j, which the spectral
     # state holds with K_j = n pi_j at the start (mean K = 1; spectral.py), so a red emission
@@ -132,13 +153,54 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
             hero = i
             pick = math.inf
     child_ps[packet.free_path_at(grid)] = 0.0
+    packet.belong_to(grid, child_ps, part)
     cos_t = quadratic.sample(floats[medium.channel_beta + channel:], uniform(rng_emitted))
     child.ux, child.uy, child.uz = turn(p.ux, p.uy, p.uz, cos_t, uniform(rng_emitted))
     child.z = p.z
     child.seg = p.seg
-    child.w = total * scale
+    child.w = emitted
     child.beam = 0
     child.part = part
     child.wavelength = hero
     child.reference = heaviest
     return n_stacked + 1
+
+
+@internal
+def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density):
+    """The emissions of a collision (each channel's row of the scratch, emit) ride on in packet
+    p, which has just turned by psi (cos_psi) from its incident direction, a direction drawn
+    with density `density` in 1/sr (spectral.direction_density): channel k's light at i gains
+    E_i p_k(psi) / density (p_k its phase function), booked as shifted into its part. The
+    packet settles first (no path since the collision's settle: no exponentials), so that the
+    collision's implicit capture is booked with the shares it had; then each wavelength's
+    shares take the new light in."""
+    spectral.settle(medium, floats, grid, tally_row, ps, p, layer)
+    if p.w <= 0.0 or density <= 0.0:
+        return
+    n = grid.n_wl
+    _, g, last, share = packet.weights(grid, ps)
+    added = work[:n]
+    for i in range(n):
+        added[i] = 0.0
+    for channel in range(1, medium.n_channels):
+        kept = work[(3 + channel) * n:(4 + channel) * n]
+        factor = quadratic.evaluate(floats[medium.channel_beta + channel:], cos_psi) / density
+        shifted_in = channel * grid.part_size + spectral_at(grid,
+                                                            grid.budget + BUDGET_SHIFTED_IN)
+        for i in range(n):
+            kept[i] *= factor
+            added[i] += kept[i]
+            tally_row[shifted_in + i] += kept[i]
+    per_w = 1.0 / p.w
+    for i in range(n):
+        if added[i] <= 0.0:
+            continue
+        after = last[i] + added[i]
+        keep = last[i] / after
+        for part in range(grid.n_parts):
+            share[part * n + i] *= keep
+        for channel in range(1, medium.n_channels):
+            share[channel * n + i] += work[(3 + channel) * n + i] / after
+        g[i] += added[i] * per_w
+        last[i] = after
