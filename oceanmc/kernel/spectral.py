@@ -233,8 +233,12 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     c = floats[row:row + n]
     dist = ps[free_path_at(grid)]
     c_h = c[p.wavelength]
-    for j in range(n):
-        weight[j] = math.exp(-(c[j] - c_h) * dist)
+    if dist > 0.0:
+        for j in range(n):
+            weight[j] = math.exp(-(c[j] - c_h) * dist)
+    else:   # settled (a collision whose emissions the packet carries on)
+        for j in range(n):
+            weight[j] = 1.0
     total = 0.0
     for j in range(n):
         total += k[j] * weight[j] * c[j]
