@@ -1,6 +1,6 @@
 """Inelastic light: `water.inelastic: {raman: {...}, chlorophyll_fluorescence: {...},
-cdom_fluorescence: {...}}`, each optional, an empty mapping the published defaults (DESIGN.md 7.4; optics/inelastic/ computes
-them, kernel/channels/inelastic.py moves the light).
+cdom_fluorescence: {...}}`, each optional, an empty mapping the published defaults (DESIGN.md
+7.4; optics/inelastic/ computes them, kernel/channels/inelastic.py moves the light).
 
 The wavelength grid must hold the light that excites what is reported: Raman light at 400 nm
 comes from about 352 nm, chlorophyll fluorescence is excited from 370 nm, CDOM fluorescence from
@@ -82,9 +82,10 @@ class CdomFluorescence(_Strict):
     l' in excitation_range_nm, the quantum yield Phi(l') (0.94-1.90% from 310 to 490 nm,
     falling to 0 at 550 nm) is re-emitted isotropically at l' <= l <= 1000 nm. a0_scale
     multiplies Hawes's quantum efficiency (his A0 table) for a CDOM that fluoresces more or
-    less than his fulvic acid; at most 50, which keeps Phi below 1 (0.95). excitation_range_nm: where absorbed light fluoresces, within
-    Hawes's A0 table and HydroLight's extension of it, 310-550 nm (the default: all of it;
-    pure-water absorption is tabulated down to 200 nm, Smith & Baker 1981)."""
+    less than his fulvic acid; at most 50, which keeps Phi below 1 (0.95).
+    excitation_range_nm: where absorbed light fluoresces, within Hawes's A0 table and
+    HydroLight's extension of it, 310-550 nm (the default: all of it; below 380 nm pure-water
+    absorption comes from Smith & Baker 1981, tabulated down to 200 nm)."""
     a0_scale: Annotated[float, Field(ge=0.0, le=50.0, allow_inf_nan=False)] = 1.0
     excitation_range_nm: tuple[Positive, Positive] = CDOM_EXCITATION_RANGE_NM
 

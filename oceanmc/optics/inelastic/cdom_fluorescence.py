@@ -11,11 +11,12 @@ B1 = 8.077e-4 1/nm, B2 = -4.57e-4 1/nm, and A0(l') at 310, 330, .., 490 nm; Hydr
 A0 with 4.00e-5 at 510 nm, 1.00e-5 at 530 nm and 0 at 550 nm (and 0 below 310 nm), linear in
 between. Emission is isotropic.
 
-Emission only at l >= l' (as HydroLight, whose inelastic source at l comes from shorter
-wavelengths): the Gaussian in 1/l reaches below l' (0.3% of it for l' = 310 nm, 3% for 490 nm,
-7% near 550 nm), which is not emitted. It is counted up to CDOM_EMISSION_MAX_NM (1000 nm, where HydroLight's
-range ends; beyond it lies less than 0.1% of the emission of 310 nm excitation and less for
-longer ones: tests/test_cdom_fluorescence.py). The quantum yield, photons emitted per photon
+Emission only at l >= l' (re-emission at a longer wavelength, as the Web Book describes it; in
+HydroLight the inelastic source at l comes from shorter wavelengths): the Gaussian in 1/l
+reaches below l' (0.3% of it for l' = 310 nm, 3% for 490 nm, 7% near 550 nm), which is not
+emitted. It is counted up to CDOM_EMISSION_MAX_NM (1000 nm, where HydroLight's range ends;
+beyond it lies less than 0.1% of the emission of 310 nm excitation and less for longer ones:
+tests/test_cdom_fluorescence.py). The quantum yield, photons emitted per photon
 absorbed, is then
 
     Phi(l') = int_{l'}^{1000 nm} eta_Y(l', l) dl     (0.94-1.90% for 310-490 nm, then to 0 at 550)
@@ -29,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...config.inelastic import CDOM_EMISSION_MAX_NM
+from ...config.inelastic import CDOM_EMISSION_MAX_NM, CDOM_EXCITATION_RANGE_NM
 
 A1 = 0.470
 A2 = 0.407
@@ -55,8 +56,9 @@ def a0(excitation_nm: np.ndarray) -> np.ndarray:
 
 
 def _centre_and_width(excitation_nm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The Gaussian's centre A1/l' + B1 and width 0.6 (A2/l' + B2) in 1/l (1/nm)."""
-    exc = np.asarray(excitation_nm, dtype=np.float64)
+    """The Gaussian's centre A1/l' + B1 and width 0.6 (A2/l' + B2) in 1/l (1/nm), those of
+    the nearest end of 310-550 nm outside it (the width would vanish at 891 nm)."""
+    exc = np.clip(excitation_nm, *CDOM_EXCITATION_RANGE_NM)
     return A1 / exc + B1, WIDTH_FACTOR * (A2 / exc + B2)
 
 
@@ -110,13 +112,15 @@ def loss(settings, wavelengths_nm: np.ndarray) -> np.ndarray:
 
 
 def redistribution(settings, excitation_nm: np.ndarray, emission_nm: np.ndarray) -> np.ndarray:
-    """f(l' -> l) = eta_Y / Phi (1/nm), integrating to 1 over the emission, inside the
-    excitation range; 0 outside it."""
+    """f(l' -> l) = eta_Y / Phi (1/nm), integrating to 1 over the emission, at every
+    excitation wavelength below CDOM_EMISSION_MAX_NM: the excitation range is in the
+    coefficient, which is interpolated linearly between traced wavelengths (optics/inelastic
+    transfer), so that what it takes between a traced wavelength inside the range and one
+    outside is re-emitted too (a redistribution cut at the range would drop up to half of an
+    edge wavelength's take), with the shape of the range's nearest end outside 310-550 nm."""
     exc = np.asarray(excitation_nm, dtype=np.float64)
-    low, high = settings.excitation_range_nm
     total = shape_integral(exc)
-    per_total = np.divide(1.0, total, out=np.zeros_like(total),
-                          where=(exc >= low) & (exc <= high) & (total > 0.0))
+    per_total = np.divide(1.0, total, out=np.zeros_like(total), where=total > 0.0)
     return per_total[:, None] * emission_shape(exc, emission_nm)
 
 
