@@ -44,19 +44,10 @@ BATCHES = 32
 DEFAULTS = CdomFluorescence()
 
 
-def hawes(excitation_nm: float, emission_nm: float, a0: float) -> float:
-    """eta_Y (1/nm) written from Hawes (1992) as the Ocean Optics Web Book prints it, with
-    A1 0.470, A2 0.407, B1 8.077e-4, B2 -4.57e-4, for l <= l' <= 1000 nm."""
-    if not excitation_nm <= emission_nm <= 1000.0:
-        return 0.0
-    centre = 0.470 / excitation_nm + 8.077e-4
-    width = 0.6 * (0.407 / excitation_nm - 4.57e-4)
-    return a0 * math.exp(-((1.0 / emission_nm - centre) / width) ** 2)
-
-
 def hawes_yield(excitation_nm: float, a0: float, top_nm: float = 1000.0) -> float:
-    """int_{l'}^{top} eta_Y dl by the trapezoid rule on 0.005 nm (the formula of hawes, with
-    numpy, and without its cut at 1000 nm)."""
+    """int_{l'}^{top} eta_Y dl by the trapezoid rule on 0.005 nm, eta_Y written from Hawes
+    (1992) as the Ocean Optics Web Book prints it, with A1 0.470, A2 0.407, B1 8.077e-4,
+    B2 -4.57e-4 (and no cut at 1000 nm)."""
     emission = np.arange(excitation_nm, top_nm + 1e-9, 0.005)
     centre = 0.470 / excitation_nm + 8.077e-4
     width = 0.6 * (0.407 / excitation_nm - 4.57e-4)

@@ -11,13 +11,12 @@ B1 = 8.077e-4 1/nm, B2 = -4.57e-4 1/nm, and A0(l') at 310, 330, .., 490 nm; Hydr
 A0 with 4.00e-5 at 510 nm, 1.00e-5 at 530 nm and 0 at 550 nm (and 0 below 310 nm), linear in
 between. Emission is isotropic.
 
-Emission only at l >= l' (re-emission at a longer wavelength, as the Web Book describes it; in
-HydroLight the inelastic source at l comes from shorter wavelengths): the Gaussian in 1/l
-reaches below l' (0.3% of it for l' = 310 nm, 3% for 490 nm, 7% near 550 nm), which is not
-emitted. It is counted up to CDOM_EMISSION_MAX_NM (1000 nm, where HydroLight's range ends;
-beyond it lies less than 0.1% of the emission of 310 nm excitation and less for longer ones:
-tests/test_cdom_fluorescence.py). The quantum yield, photons emitted per photon
-absorbed, is then
+Emission only at l >= l' (re-emission at a longer wavelength, as the Web Book describes it):
+the Gaussian in 1/l reaches below l' (0.3% of it for l' = 310 nm, 3% for 490 nm, 7% near
+550 nm), which is not emitted. It is counted up to CDOM_EMISSION_MAX_NM (1000 nm, where
+HydroLight's range ends; beyond it lies less than 0.1% of the emission of 310 nm excitation and
+less for longer ones: tests/test_cdom_fluorescence.py). The quantum yield, photons emitted per
+photon absorbed, is then
 
     Phi(l') = int_{l'}^{1000 nm} eta_Y(l', l) dl     (0.94-1.90% for 310-490 nm, then to 0 at 550)
 
