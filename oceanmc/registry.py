@@ -68,10 +68,16 @@ SURFACE = {
 # Collision channels: name -> (kernel model id, module in kernel/channels/). Elastic scattering
 # is every scene's; inelastic processes (water.inelastic, each a module in optics/inelastic/ of
 # the same name) add theirs, all run by channels/inelastic.py from their packed transfer.
+# The kernel reads no inelastic channel's id (MEDIUM channel_model only records which process
+# a channel is), so CDOM fluorescence's is kept here rather than in kernel/models.py, whose
+# every edit starts a fresh compile cache (kernel/compile.py) and a new kernel commit for the
+# benchmark and validation reports; it moves there with the next kernel change.
+CHANNEL_CDOM_FLUORESCENCE = 3
 CHANNEL = {
     "elastic": (models.CHANNEL_ELASTIC, "elastic"),
     "raman": (models.CHANNEL_RAMAN, "inelastic"),
     "chlorophyll_fluorescence": (models.CHANNEL_CHLOROPHYLL_FLUORESCENCE, "inelastic"),
+    "cdom_fluorescence": (CHANNEL_CDOM_FLUORESCENCE, "inelastic"),
 }
 
 # Sky radiance shapes: schema name -> kernel model id; a map ({map: FILE}) is SKY_MAP or, with

@@ -127,16 +127,19 @@ def templates(folder):
                       bottom={"model": "none"}, tallies=SMALL_TALLIES),
         "specular": _mono(bottom={"model": "specular", "reflectance": 0.5},
                           tallies=SMALL_TALLIES),
-        # the grid is extended for the excitation (config/inelastic.py): 520-700 nm traced
+        # the grid is extended for the excitation (config/inelastic.py): 500-700 nm traced
         "inelastic": _mono(
             wavelengths_nm={"start": 660, "stop": 700, "step": 20}, tallies=SMALL_TALLIES,
             water={"layers": [{"thickness_m": 2.0, "components": [
-                {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": 1.0}]}],
+                {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": 1.0},
+                {"model": "cdom", "a440": 0.1, "slope": 0.014}]}],
                 "inelastic": {"raman": {"b488_per_m": 2.6e-4, "exponent": 5.5,
                                         "phase_beta": 0.55},
                               "chlorophyll_fluorescence": {
                                   "quantum_yield": 0.02, "peak_nm": 685, "sigma_nm": 10.6,
                                   "excitation_range_nm": [600, 690]},
+                              "cdom_fluorescence": {"a0_scale": 1.0,
+                                                    "excitation_range_nm": [500, 550]},
                               "max_step_nm": 10}},
             estimator={"emission_weight": 0.01}),
         "bottom_mixture_spectra": _mono(
@@ -409,6 +412,18 @@ def test_ed0_below_1e_minus_100_is_refused_its_variances_would_underflow(tmp_pat
     one_line(str(info.value))
     assert "illumination.Ed0 = 1e-50 times the spectrum's Ed0 falls to 1e-110 at 400 nm; " \
            "allowed: at least 1e-100" in str(info.value)
+
+
+def test_emission_weight_below_1e_minus_100_is_refused(scenes):
+    """emission_weight = 5e-324 gave NaN results in the inelastic template once it had three
+    processes (an emitted packet's spectral weights divide by what it carries, at least
+    emission_weight per wavelength, which overflowed): refused below 1e-100."""
+    scene = copy.deepcopy(scenes["inelastic"])
+    for weight, shown in ((5e-324, "5e-324"), (1e-300, "1e-300"), (1e-101, "1e-101")):
+        scene["estimator"]["emission_weight"] = weight
+        refused(scene, f"estimator.emission_weight = {shown}", "allowed: 1e-100 .. 1")
+    scene["estimator"]["emission_weight"] = 1e-100
+    assert not finite(oceanmc.simulate(scene, threads=1))
 
 
 def test_an_infinitely_deep_layer_over_a_bottom_is_refused_naming_its_thickness():

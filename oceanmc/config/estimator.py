@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Optional, Union
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from .base import _Strict
 
@@ -12,6 +12,11 @@ from .base import _Strict
 # in 20-30 s where it took 1,000-10,000 s without it (benchmarks/real_scenes.md)
 AUTO_UPWARD_FRACTION = 0.1
 DEFAULT_EMISSION_WEIGHT = 0.003
+# the least emission_weight: an emitted packet carries at least emission_weight per wavelength,
+# and its spectral weights divide by what it carries (kernel/channels/inelastic.py), which
+# overflows below about 1e-308: emission_weight 5e-324 gave NaN results with three inelastic
+# processes (tests/test_fuzz_numeric_keys.py)
+MIN_EMISSION_WEIGHT = 1e-100
 
 
 class Estimator(_Strict):
@@ -48,3 +53,11 @@ class Estimator(_Strict):
     # (benchmarks/inelastic.md)
     emission_weight: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = \
         DEFAULT_EMISSION_WEIGHT
+
+    @field_validator("emission_weight")
+    @classmethod
+    def _emission_weight_floor(cls, weight: float) -> float:
+        if weight < MIN_EMISSION_WEIGHT:   # pydantic would write 1e-100 out in 100 decimals
+            raise ValueError(f"allowed: {MIN_EMISSION_WEIGHT:g} .. 1 (an emitted packet's "
+                             "spectral weights divide by it)")
+        return weight

@@ -1,9 +1,10 @@
-"""Inelastic light: `water.inelastic: {raman: {...}, chlorophyll_fluorescence: {...}}`, each
-optional, an empty mapping the published defaults (DESIGN.md 7.4; optics/inelastic/ computes
-them, kernel/channels/inelastic.py moves the light).
+"""Inelastic light: `water.inelastic: {raman: {...}, chlorophyll_fluorescence: {...},
+cdom_fluorescence: {...}}`, each optional, an empty mapping the published defaults (DESIGN.md
+7.4; optics/inelastic/ computes them, kernel/channels/inelastic.py moves the light).
 
 The wavelength grid must hold the light that excites what is reported: Raman light at 400 nm
-comes from about 352 nm, chlorophyll fluorescence is excited from 370 nm. transport_grid() gives
+comes from about 352 nm, chlorophyll fluorescence is excited from 370 nm, CDOM fluorescence from
+310 nm. transport_grid() gives
 the grid the run traces: the requested wavelengths, extended below them down to the lowest
 excitation wavelength needed and with no gap wider than max_step_nm in the excitation range.
 The run then reports every traced wavelength and its summary names those it added."""
@@ -23,6 +24,11 @@ Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 # lines at +-5 standard deviations) Walrafen's four Gaussians hold less than 1e-6 of the light
 # and fall to 2e-6 of their peak
 RAMAN_SHIFT_RANGE = (2800.0, 3950.0)
+# CDOM fluorescence (optics/inelastic/cdom_fluorescence.py): Hawes (1992) measured the
+# excitation 310-490 nm, HydroLight extends A0 to 0 at 550 nm; its emission is counted up to
+# 1000 nm, where HydroLight's wavelength range ends
+CDOM_EXCITATION_RANGE_NM = (310.0, 550.0)
+CDOM_EMISSION_MAX_NM = 1000.0
 
 
 class Raman(_Strict):
@@ -70,12 +76,45 @@ class ChlorophyllFluorescence(_Strict):
         return abs(emission_nm - self.peak_nm) <= 6.0 * self.sigma_nm
 
 
+class CdomFluorescence(_Strict):
+    """CDOM fluorescence after Hawes (1992), as HydroLight uses it (optics/inelastic/
+    cdom_fluorescence.py has the formula and its constants): of the photons CDOM absorbs at
+    l' in excitation_range_nm, the quantum yield Phi(l') (0.94-1.90% from 310 to 490 nm,
+    falling to 0 at 550 nm) is re-emitted isotropically at l' <= l <= 1000 nm. a0_scale
+    multiplies Hawes's quantum efficiency (his A0 table) for a CDOM that fluoresces more or
+    less than his fulvic acid; at most 50, which keeps Phi below 1 (0.95).
+    excitation_range_nm: where absorbed light fluoresces, within Hawes's A0 table and
+    HydroLight's extension of it, 310-550 nm (the default: all of it; below 380 nm pure-water
+    absorption comes from Smith & Baker 1981, tabulated down to 200 nm)."""
+    a0_scale: Annotated[float, Field(ge=0.0, le=50.0, allow_inf_nan=False)] = 1.0
+    excitation_range_nm: tuple[Positive, Positive] = CDOM_EXCITATION_RANGE_NM
+
+    @model_validator(mode="after")
+    def _within_hawes(self) -> "CdomFluorescence":
+        low, high = self.excitation_range_nm
+        lowest, highest = CDOM_EXCITATION_RANGE_NM
+        if not lowest <= low < high <= highest:
+            raise ValueError(f"excitation_range_nm = [{low:g}, {high:g}]; allowed: an "
+                             f"increasing pair within [{lowest:g}, {highest:g}] nm, where "
+                             "Hawes's (1992) quantum efficiency is tabulated (with HydroLight's "
+                             "extension to 550 nm)")
+        return self
+
+    def excitation_nm(self, emission_nm: float) -> tuple[float, float]:
+        return self.excitation_range_nm[0], min(self.excitation_range_nm[1], emission_nm)
+
+    def emits_at(self, emission_nm: float) -> bool:
+        """Emission at l comes from excitation at l' <= l, up to CDOM_EMISSION_MAX_NM."""
+        return self.excitation_range_nm[0] < emission_nm <= CDOM_EMISSION_MAX_NM
+
+
 class Inelastic(_Strict):
     """The inelastic processes of the water; each off unless given. max_step_nm: the widest
     gap the traced grid may have where it excites light (the excitation spectrum is
     interpolated linearly between traced wavelengths)."""
     raman: Optional[Raman] = None
     chlorophyll_fluorescence: Optional[ChlorophyllFluorescence] = None
+    cdom_fluorescence: Optional[CdomFluorescence] = None
     max_step_nm: Annotated[float, Field(ge=0.5, le=50.0, allow_inf_nan=False)] = 10.0
 
     def processes(self) -> list[tuple[str, object]]:
@@ -85,7 +124,7 @@ class Inelastic(_Strict):
 
 
 # the processes in channel order (kernel/channels/: channel k + 1 is process k)
-PROCESSES = ("raman", "chlorophyll_fluorescence")
+PROCESSES = ("raman", "chlorophyll_fluorescence", "cdom_fluorescence")
 
 
 def transport_grid(requested: np.ndarray, inelastic: Inelastic) -> np.ndarray:

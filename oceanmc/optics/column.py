@@ -50,6 +50,7 @@ class LayerIOPs:
     #                             to 1 (a wavelength that does not scatter: any valid row)
     config_layer: int           # index in config.water.layers
     a_phytoplankton: np.ndarray | None = None   # (n_wl,) the part of a that may fluoresce
+    a_cdom: np.ndarray | None = None            # (n_wl,) CDOM's part of a, which may fluoresce
 
     @property
     def c(self) -> np.ndarray:
@@ -82,15 +83,20 @@ def mix(parts: list[Contribution]) -> Contribution:
     weights = np.stack(columns, axis=1)
     empty = b <= 0.0
     weights[empty] = np.stack(fallback, axis=1)[empty]
-    living = [p.a_phytoplankton for p in parts if p.a_phytoplankton is not None]
-    return Contribution(a, b, tuple(phases), weights,
-                        np.sum(living, axis=0) if living else None)
+    return Contribution(a, b, tuple(phases), weights, _sum_of(parts, "a_phytoplankton"),
+                        _sum_of(parts, "a_cdom"))
+
+
+def _sum_of(parts: list[Contribution], name: str) -> np.ndarray | None:
+    """The sum of the parts' absorption `name` (a_phytoplankton, a_cdom), None if none has it."""
+    given = [getattr(p, name) for p in parts if getattr(p, name) is not None]
+    return np.sum(given, axis=0) if given else None
 
 
 def _layer(part: Contribution, top: float, thickness: float, index: int) -> LayerIOPs:
     fractions = np.array([backscatter_fraction(p) for p in part.phases])
     return LayerIOPs(top, thickness, part.a, part.b, part.b * (part.weights @ fractions),
-                     part.phases, part.weights, index, part.a_phytoplankton)
+                     part.phases, part.weights, index, part.a_phytoplankton, part.a_cdom)
 
 
 def _given(layer: cfg.Layer, n_wl: int) -> Contribution:

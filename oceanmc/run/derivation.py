@@ -343,10 +343,10 @@ NOT_SPLIT = frozenset({"air/t_up", "air/rho", "air/rho_local"})
 
 def add_parts(whole: Result, parts: dict[str, Result]) -> None:
     """Adds to `whole` every quantity of each part of the light (elastic, raman,
-    chlorophyll_fluorescence: the parts of the tally row, kernel/channels/) under the part's
-    name: raman/air/Rrs_nadir is the Raman light's Rrs, and the parts of a quantity add up to
-    it batch by batch, so each part has its own standard error. Ratios are not split
-    (NOT_SPLIT)."""
+    chlorophyll_fluorescence, cdom_fluorescence: the parts of the tally row, kernel/channels/)
+    under the part's name: raman/air/Rrs_nadir is the Raman light's Rrs, and the parts of a
+    quantity add up to it batch by batch, so each part has its own standard error. Ratios are
+    not split (NOT_SPLIT)."""
     for part_name, part in parts.items():
         for name, q in part.quantities.items():
             if name in NOT_SPLIT:
@@ -360,6 +360,7 @@ PART_DESCRIPTIONS = {
     "elastic": "the light no inelastic process has emitted",
     "raman": "the light Raman scattering by water emitted",
     "chlorophyll_fluorescence": "the light phytoplankton fluoresced",
+    "cdom_fluorescence": "the light CDOM fluoresced",
 }
 
 

@@ -163,7 +163,7 @@ def value_cell(value: float, err: float) -> str:
 
 # the parts of the light (add_parts) as the summary's headings and the plots' legends name them
 PART_LABELS = {"elastic": "elastic", "raman": "Raman",
-               "chlorophyll_fluorescence": "fluorescence"}
+               "chlorophyll_fluorescence": "fluorescence", "cdom_fluorescence": "CDOM fluor."}
 
 
 def light_parts(result: Result) -> list[str]:
@@ -221,6 +221,10 @@ def process_descriptions(result: Result) -> list[str]:
             said.append(f"chlorophyll fluorescence (quantum yield {process.quantum_yield:g}, "
                         f"{process.peak_nm:g} nm, sigma {process.sigma_nm:g} nm, excited "
                         f"{low:g}-{high:g} nm)")
+        elif name == "cdom_fluorescence":
+            low, high = process.excitation_range_nm
+            said.append(f"CDOM fluorescence (Hawes 1992, quantum efficiency x "
+                        f"{process.a0_scale:g}, excited {low:g}-{high:g} nm)")
         else:
             said.append(PART_LABELS.get(name, name))
     return said
@@ -257,7 +261,8 @@ def inelastic_lines(result: Result) -> list[str]:
 def rrs_parts_table(result: Result) -> list[str]:
     """For a run with inelastic light: Rrs nadir of each part of the light per wavelength, its
     relative standard error and its share of the whole Rrs nadir; [] without inelastic light or
-    without Rrs nadir. The elastic part and both processes fit SUMMARY_WIDTH (77 characters)."""
+    without Rrs nadir. The elastic part and all three processes fit SUMMARY_WIDTH (96
+    characters)."""
     parts = [part for part in light_parts(result) if f"{part}/air/Rrs_nadir" in result]
     if not parts or "air/Rrs_nadir" not in result:
         return []

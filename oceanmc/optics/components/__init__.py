@@ -27,6 +27,8 @@ class Contribution:
     # (n_wl,) 1/m: the part of a absorbed by phytoplankton, which fluoresces
     # (optics/inelastic/); None: none
     a_phytoplankton: np.ndarray | None = None
+    # (n_wl,) 1/m: the part of a absorbed by CDOM, which fluoresces; None: none
+    a_cdom: np.ndarray | None = None
 
 
 def per_wavelength(value, n_wl: int) -> np.ndarray:

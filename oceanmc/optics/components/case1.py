@@ -11,7 +11,10 @@ Particles (phytoplankton and the detritus that covaries with them), absorption:
 CDOM, covarying with the particles:
     a_CDOM(l) = 0.2 a_p(440) exp(-0.014 (l - 440))
   (HydroLight's f_CDOM = 0.2 and S_CDOM = 0.014 1/nm; Bricaud et al. 1998 wrote 0.2 (a_w(440) +
-  a_p(440)), HydroLight drops a_w so that Chl = 0 is pure water, and so do we).
+  a_p(440)), HydroLight drops a_w so that Chl = 0 is pure water, and so do we). It is CDOM,
+  and fluoresces as the `cdom` component's does (optics/inelastic/cdom_fluorescence.py): CDOM
+  fluorescence takes what CDOM absorbs, all of it (Mobley, Ocean Optics Web Book, "CDOM
+  fluorescence": its inelastic scattering coefficient b_Y is a_Y).
 Particle scattering (Loisel & Morel 1998 via Morel & Maritorena 2001, J. Geophys. Res. 106, 7163;
 spectral shape of Morel et al. 2002, Appl. Opt. 41, 6289):
     b_p(l) = 0.416 Chl^0.766 (l / 550)^nu,
@@ -93,8 +96,10 @@ def iops(component, wavelengths_nm: np.ndarray, where: str) -> Contribution:
     if chl <= 0.0:
         zero = np.zeros(n_wl)
         return Contribution(zero, zero.copy(), phases, np.tile([1.0, 0.0], (n_wl, 1)))
-    a = particle_absorption(chl, wavelengths_nm) + cdom_absorption(chl, wavelengths_nm)
+    a_cdom = cdom_absorption(chl, wavelengths_nm)
     alpha = small_share(chl)
-    return Contribution(a, scattering(chl, wavelengths_nm), phases,
+    return Contribution(particle_absorption(chl, wavelengths_nm) + a_cdom,
+                        scattering(chl, wavelengths_nm), phases,
                         np.tile([1.0 - alpha, alpha], (n_wl, 1)),
-                        a_phytoplankton=phytoplankton_absorption(chl, wavelengths_nm))
+                        a_phytoplankton=phytoplankton_absorption(chl, wavelengths_nm),
+                        a_cdom=a_cdom)
