@@ -228,6 +228,14 @@ def elastic_only():
 
 
 @pytest.fixture(scope="module")
+def packets():
+    """The run with each emission in a packet of its own (estimator.emitted_light)."""
+    config = scene(True)
+    config["estimator"] = {"emitted_light": "packets"}
+    return oceanmc.simulate(config, threads=2)
+
+
+@pytest.fixture(scope="module")
 def packed():
     """(traced grid, Ed0, the layer, the CDOM channel) of the scene."""
     config = oceanmc.load_config(scene(True))
@@ -269,18 +277,34 @@ def test_every_part_budget_closes(whole):
     print("budget closure max |z|:", worst)
 
 
-def test_elastic_part_is_the_run_without_it(whole, elastic_only):
-    """CDOM fluorescence adds no loss (CDOM's absorption is already in a) and draws from its
-    own random stream: the elastic part is the run without it, bit for bit."""
+def test_elastic_part_is_the_run_without_it(packets, whole, elastic_only):
+    """CDOM fluorescence adds no loss (CDOM's absorption is already in a). With emitted
+    packets, which draw from their own random stream, the elastic part is the run without it,
+    bit for bit; with the light carried on (the default) roulette weighs all the light a
+    packet carries, and the elastic part agrees within |z| < Z_MAX."""
     for name in ("Ed", "Eu", "Lu", "Eo", "air/Rrs_nadir", "budget/water_leaving",
                  "budget/lost_below", "budget/absorbed_bottom"):
-        np.testing.assert_array_equal(whole.quantities[f"elastic/{name}"].batches,
+        np.testing.assert_array_equal(packets.quantities[f"elastic/{name}"].batches,
                                       elastic_only.quantities[name].batches, err_msg=name)
+        z = z_of(whole[f"elastic/{name}"] - elastic_only[name],
+                 np.hypot(whole.stderr(f"elastic/{name}"), elastic_only.stderr(name)), 0.0)
+        assert (np.abs(z) < Z_MAX).all(), (name, z)
     # what it takes is booked out of the absorption (to rounding: (a - x) + x)
     np.testing.assert_allclose(
-        whole.quantities["elastic/budget/absorbed_layer_1"].batches
-        + whole.quantities["elastic/budget/shifted_out"].batches,
+        packets.quantities["elastic/budget/absorbed_layer_1"].batches
+        + packets.quantities["elastic/budget/shifted_out"].batches,
         elastic_only.quantities["budget/absorbed_layer_1"].batches, rtol=1e-13, atol=0.0)
+
+
+def test_carried_light_agrees_with_emitted_packets(whole, packets):
+    """Two estimators of the CDOM part, independent draws: |z| < Z_MAX where it is lit."""
+    for name in ("air/Rrs_nadir", "Ed", "Eu", "budget/shifted_in"):
+        quantity = f"cdom_fluorescence/{name}"
+        reference = packets[quantity]
+        lit = np.abs(reference) > 1e-3 * np.abs(reference).max()
+        z = z_of(whole[quantity] - reference,
+                 np.hypot(whole.stderr(quantity), packets.stderr(quantity)), 0.0)[lit]
+        assert (np.abs(z) < Z_MAX).all(), (quantity, z)
 
 
 def test_take_is_yield_times_cdom_absorption(whole, packed):
