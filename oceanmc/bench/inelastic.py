@@ -39,6 +39,7 @@ RUNS = (("elastic only", None, None),
 ROWS = (("Rrs(550)", "air/Rrs_nadir", 550.0),
         ("elastic Rrs(550)", "elastic/air/Rrs_nadir", 550.0),
         ("Raman Rrs(550)", "raman/air/Rrs_nadir", 550.0),
+        ("Raman Eu(0-, 550)", "raman/Eu", 550.0),
         ("fluorescence Rrs(680)", "chlorophyll_fluorescence/air/Rrs_nadir", 680.0))
 
 
@@ -72,8 +73,10 @@ def _run(config: dict) -> tuple[float, dict]:
     for label, quantity, wavelength in ROWS:
         if quantity in result:
             k = int(np.argmin(np.abs(grid - wavelength)))
-            value = float(result[quantity][k])
-            out[label] = (value, float(result.stderr(quantity)[k]) / abs(value))
+            # (an irradiance at its first tally depth, 0-)
+            value = float(np.ravel(result[quantity][k])[0])
+            stderr = float(np.ravel(result.stderr(quantity)[k])[0])
+            out[label] = (value, stderr / abs(value))
     return elapsed, out
 
 
@@ -143,7 +146,7 @@ def report_lines(data: dict, commit: str) -> list[str]:
         f"reaches 1% in {default['rows']['elastic Rrs(550)']['time_to_target_s']:,.1f} s "
         f"against the elastic run's {own:,.1f} s."]
     packets = runs["inelastic, packets"]["rows"]
-    for row in ("Raman Rrs(550)", "fluorescence Rrs(680)"):
+    for row in ("Raman Rrs(550)", "Raman Eu(0-, 550)", "fluorescence Rrs(680)"):
         carried_t = default["rows"][row]["time_to_target_s"]
         packets_t = packets[row]["time_to_target_s"]
         lines.append(f"{row} to 1% with the emitted light carried on by the emitting packet "
