@@ -15,7 +15,10 @@ from ..rng import uniform
 # where the packet carries emissions on (channels/inelastic.py), the share of its new
 # directions drawn uniformly over the sphere: the emitted light, nearly isotropic, then weighs
 # at most 4 pi p_e / EMISSION_SHARE (<= 1.3 / EMISSION_SHARE for Raman's phase function) where
-# the elastic phase function, peaked forward, rarely sends the packet
+# the elastic phase function, peaked forward, rarely sends the packet. Measured (clear water,
+# the inelastic bench's scene, 2 runs of 100k photons each, time to 1%): 0.2 against 0.5,
+# Raman Rrs(550) 1.0-1.1 s against 1.2 s, fluorescence Rrs(680) 0.5-0.6 s against 0.7-0.9 s,
+# Raman Eu(0-, 550) 3.2-4.4 s against 1.9-3.4 s; without it (0) Eu had 2.6 times the variance
 EMISSION_SHARE = 0.2
 
 
