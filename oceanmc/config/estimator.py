@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Optional, Union
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from .base import _Strict
 
@@ -24,7 +24,13 @@ class Estimator(_Strict):
     uniformly in the cone of half-angle upward_cone_deg around straight up (in a layer of
     single-scattering albedo w0 the fraction is min(upward_fraction, 1 - w0)); for Lu,
     Lw_nadir and Rrs_nadir. auto (the default): AUTO_UPWARD_FRACTION in a spectral scene of
-    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py)."""
+    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py).
+    depth_splitting: depth importance weight windows (scene/weight_window.py): packets are
+    split as they go deeper and play roulette as they come up, so that light is followed as
+    well at the deepest tally depth as near the surface. auto (the default): on in an implicit
+    walk without inelastic light whose deepest tally depth lies at least
+    scene.weight_window.AUTO_ATTENUATION_DEPTHS attenuation depths down; on: whenever the
+    tallies go below the surface; off: never."""
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
@@ -36,9 +42,20 @@ class Estimator(_Strict):
     # at least 0.01 deg: the kernel draws cos psi = 1 - u (1 - cos A), whose 1 - cos A is
     # accurate to 1e-8 relative there and loses all accuracy near 1e-6 deg
     upward_cone_deg: Annotated[float, Field(ge=0.01, le=90.0, allow_inf_nan=False)] = 15.0
+    depth_splitting: Literal["auto", "on", "off"] = "auto"
     # the least weight of a packet that an inelastic process (water.inelastic) emits; lighter
     # emissions are made with probability weight / emission_weight and carry emission_weight
     # (kernel/channels/inelastic.py). The default measured best for the Raman part of Rrs in
     # clear water (benchmarks/inelastic.md)
     emission_weight: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = \
         DEFAULT_EMISSION_WEIGHT
+
+    @field_validator("depth_splitting", mode="before")
+    @classmethod
+    def _yaml_switch(cls, value):
+        # YAML 1.1 reads a bare on / off as true / false
+        if value is True:
+            return "on"
+        if value is False:
+            return "off"
+        return value
