@@ -11,7 +11,7 @@ import numpy as np
 from .. import config as cfg
 from .. import optics
 from ..kernel.records import ESTIMATOR, SPLIT_STACK_ROWS, merge, record
-from . import bottom, estimates, grid, medium, sky, surface
+from . import bottom, estimates, grid, medium, sky, surface, weight_window
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
 
@@ -58,7 +58,8 @@ class Scene:
 
 def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:
     """The ESTIMATOR records, one per segment of the column: under depth windows each holds its
-    segment's window weight and a roulette threshold scaled by it (scene/weight_window.py)."""
+    segment's window weight W and the roulette threshold at collisions there, max(roulette_weight,
+    weight_window.ROULETTE_WEIGHT) x W (scene/weight_window.py)."""
     upward = medium.upward_fractions(est, column.albedo)
     rows = np.repeat(record(ESTIMATOR, analog=int(est.mode == "analog"),
                             roulette_weight=float(est.roulette_weight),
@@ -70,8 +71,10 @@ def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:
                             emission_weight=float(est.emission_weight),
                             depth_windows=int(column.windows.on), window=1.0),
                      len(column.window))
-    rows["window"] = column.window
-    rows["roulette_weight"] *= column.window
+    if column.windows.on:
+        rows["window"] = column.window
+        rows["roulette_weight"] = max(est.roulette_weight, weight_window.ROULETTE_WEIGHT) * \
+            column.window
     return rows
 
 

@@ -25,11 +25,14 @@ and the bottom); where a segment above the deepest tally spans more than PLANE_S
 depths, planes without tallies are added in it, so that W changes by at most a factor 2 from
 one segment to the next and a packet is split or rouletted a little at a time.
 
-When windows are on, Russian roulette at collisions (estimator.roulette_weight) would kill the
-deep packets the windows made (a weight W of e^-10 is far below 1e-3); the window's own
-roulette replaces it, and the threshold at collisions becomes roulette_weight times the
-lowest window, a backstop for packets that stay in one segment (MCNP turns its weight cutoff
-off under weight windows for the same reason).
+When windows are on, Russian roulette at collisions below estimator.roulette_weight would kill
+the deep packets the windows made (a weight W of e^-10 is far below 1e-3): its threshold
+becomes ROULETTE_WEIGHT x W in each segment (max(roulette_weight, ROULETTE_WEIGHT) where a
+larger roulette_weight is asked for), as MCNP scales its weight cutoff by the importance. A
+packet that has lost most of its weight there is worth less than under a plain walk, since the
+windows keep the population up with fresh copies: on the bench's deep scene, 0.01 W reached
+every tally's 1% 1.8 times sooner than 0.001 W (the worst over Ed, Eou and Lu), 0.03 W lost
+Lu by 1.8 times (benchmarks/deep.md).
 """
 from __future__ import annotations
 
@@ -50,6 +53,8 @@ AUTO_ATTENUATION_DEPTHS = 2.0
 MEAN_COSINE = 0.75
 # the largest step of the window from one segment to the next, in attenuation depths (W halves)
 PLANE_STEP = math.log(2.0)
+# the roulette threshold at collisions under windows, relative to the segment's window
+ROULETTE_WEIGHT = 0.01
 
 
 @dataclass(frozen=True)
