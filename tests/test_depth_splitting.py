@@ -160,6 +160,9 @@ def test_auto_rule():
     config = oceanmc.load_config(raman)
     assert weight_window.choose(config, optics.column_iops(config)).why == \
         "off (auto: inelastic light)"
+    raman["estimator"]["depth_splitting"] = "on"
+    with pytest.raises(ConfigError, match="depth_splitting = 'on' with water.inelastic"):
+        oceanmc.load_config(raman)
 
 
 @pytest.mark.parametrize("value, expected", [("off", "off"), (False, "off"), ("on", "on"),

@@ -30,7 +30,7 @@ class Estimator(_Strict):
     well at the deepest tally depth as near the surface. auto (the default): on in an implicit
     walk without inelastic light whose deepest tally depth lies at least
     scene.weight_window.AUTO_ATTENUATION_DEPTHS attenuation depths down; on: whenever the
-    tallies go below the surface; off: never."""
+    tallies go below the surface (not with inelastic light); off: never."""
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1

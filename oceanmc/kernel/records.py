@@ -153,8 +153,8 @@ ESTIMATES = _record(
 # its planes, MEDIUM plane_z): the rows differ only where depth windows change them
 # (kernel/weight_window.py, scene/weight_window.py).
 # emission_weight: the least weight of a packet an inelastic process emits (lighter emissions
-# play roulette up to it: kernel/channels/inelastic.py); depth_windows: the elastic light's
-# packets are split on entering a segment whose window weight `window` they exceed;
+# play roulette up to it: kernel/channels/inelastic.py); depth_windows: packets are split on
+# entering a segment whose window weight `window` they exceed (never with inelastic light);
 # roulette_weight: the roulette threshold at collisions in the segment (the configured one
 # times the window)
 ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",

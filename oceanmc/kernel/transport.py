@@ -459,7 +459,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
                                                   floats, ints, bp, tally, ps, work, p, draws)
-                    elif ctrl.depth_windows and p.part == 0:
+                    elif ctrl.depth_windows:
                         n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
                                                weight_window.copies(ctrl_row[p.seg], grid, p,
                                                                     ps))

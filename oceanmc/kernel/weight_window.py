@@ -1,14 +1,15 @@
-"""Depth importance weight windows: how many copies a packet of the elastic light becomes on
-entering a segment of the water column (transport.trace_batch, through split_into), against
-the segment's window weight W (the segment's ESTIMATOR row; scene/weight_window.py says how W
-falls with depth and why).
+"""Depth importance weight windows: how many copies a packet becomes on entering a segment of
+the water column (transport.trace_batch, through split_into), against the segment's window
+weight W (the segment's ESTIMATOR row; scene/weight_window.py says how W falls with depth and
+why).
 
 The packet's standing is r = w / W, with w its heaviest wavelength's weight in a spectral walk
 (settled on the plane: kernel/spectral.py, so that p.w G_j is wavelength j's weight). Above
 the window, r > UPPER, it is split into k = min(round(r), MAX_COPIES) copies of w / k, unbiased
-whatever k (Kalos & Whitlock, Monte Carlo Methods, 2nd ed. 2008, 6.4); the bounds are MCNP's
-defaults (X-5 Monte Carlo Team, MCNP 5 manual vol. I, LA-UR-03-1987, 2.VII.C.2 and the WWP
-card: an upper bound 5/3 of the survival weight, at most 5 copies per split).
+whatever k (Kalos & Whitlock, Monte Carlo Methods, 2nd ed. 2008, on splitting); the bounds are
+MCNP's weight-window defaults (X-5 Monte Carlo Team, MCNP5 manual vol. I, LA-UR-03-1987, the
+WWP card: an upper bound 5 times the lower and a survival weight 3 times it, so 5/3 of the
+survival weight; at most 5 splits per event).
 
 Below the window nothing happens at the plane: the roulette at collisions, whose threshold
 each segment's row scales by its W (MCNP scales its weight cutoff by the importance in the same

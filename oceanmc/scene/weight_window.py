@@ -4,12 +4,13 @@ Light deep in the water is a deep-penetration problem: over 10 attenuation depth
 e^-10, and an implicit-capture walk sends ever fewer packets there, so that the relative
 variance of a tally at depth z grows about as fast as the light falls. Splitting and Russian
 roulette by importance keep the packet population even with depth (Kalos & Whitlock, Monte
-Carlo Methods, 2nd ed. 2008, 6.3-6.4; Booth, "A sample problem for variance reduction in MCNP",
-LA-10363-MS, 1985): the water column is cut into depth segments, each with a window weight W,
-and a packet that enters a segment far heavier than W is split into copies near W, one far
-lighter plays roulette for W (MCNP's weight windows: X-5 Monte Carlo Team, MCNP 5 manual vol. I,
-LA-UR-03-1987, 2.VII.C.2; OpenMC's the same). The importance of a packet for tallies at depth
-is the inverse of the light expected there, so W falls with depth as the light does:
+Carlo Methods, 2nd ed. 2008, on splitting and Russian roulette; Booth, "A sample problem for
+variance reduction in MCNP", LA-10363-MS, 1985): the water column is cut into depth segments,
+each with a window weight W, and a packet that enters a segment far heavier than W is split
+into copies near W (MCNP's weight windows: X-5 Monte Carlo Team, MCNP5 manual vol. I,
+LA-UR-03-1987; OpenMC's the same), while packets that lose weight play roulette at a threshold
+scaled by W (below). The importance of a packet for tallies at depth is the inverse of the
+light expected there, so W falls with depth as the light does:
 
     W(z) = exp(-zeta(z)),  zeta(z) = integral_0^z K dz',  K = (a + b_b) / MEAN_COSINE,
 
@@ -30,9 +31,10 @@ the deep packets the windows made (a weight W of e^-10 is far below 1e-3): its t
 becomes ROULETTE_WEIGHT x W in each segment (max(roulette_weight, ROULETTE_WEIGHT) where a
 larger roulette_weight is asked for), as MCNP scales its weight cutoff by the importance. A
 packet that has lost most of its weight there is worth less than under a plain walk, since the
-windows keep the population up with fresh copies: on the bench's deep scene, 0.01 W reached
-every tally's 1% 1.8 times sooner than 0.001 W (the worst over Ed, Eou and Lu), 0.03 W lost
-Lu by 1.8 times (benchmarks/deep.md).
+windows keep the population up with fresh copies: on the bench's deep scene (bench/deep.py,
+upward bias 0.1, 3 interleaved runs of 300,000 photons) 0.01 W brought every Ed, Eou and Lu to
+1% 1.8 times sooner than 0.001 W (the worst of them: 52 s against 94 s), and 0.03 W lost Lu by
+1.8 times.
 """
 from __future__ import annotations
 
@@ -47,9 +49,12 @@ from .. import optics
 # estimator.depth_splitting auto: on when the deepest tally depth lies at least this many
 # attenuation depths (zeta, at the least attenuated wavelength) down
 AUTO_ATTENUATION_DEPTHS = 2.0
-# the mean cosine of the diffuse downwelling light in K = (a + b_b) / MEAN_COSINE (0.75 matched
-# the light's own decay in the bench's deep scene, benchmarks/deep.md, within 10%; a K too
-# small splits too little at depth, one too large splits more than needed)
+# the mean cosine of the diffuse downwelling light in K = (a + b_b) / MEAN_COSINE: with 0.75
+# zeta matches ln(Ed(0-) / Ed(z)) of the bench's deep scene (benchmarks/deep.md) within 3%
+# from 30 m (2.5 attenuation depths) to 110 m (10.9), and within 14% above. A K too small
+# splits too little at depth, one too large more than needed (measured there, 2 runs each,
+# roulette at 0.001 W: 0.65 took 2.6 times the events per photon of 0.75 and gained nothing;
+# 0.9 half the events, and 2 to 5 times the worst time to 1% of Ed, Eou and Lu)
 MEAN_COSINE = 0.75
 # the largest step of the window from one segment to the next, in attenuation depths (W halves)
 PLANE_STEP = math.log(2.0)
@@ -85,12 +90,11 @@ def choose(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> DepthWind
         return DepthWindows(False, "off", deepest)
     zeta = float(attenuation_depths(layers, [deepest])[0])
     where = f"the deepest tally depth {deepest:g} m at {zeta:.2f} attenuation depths"
-    if mode == "on":
+    if mode == "on":   # never with inelastic light (config/scene.py refuses it)
         return DepthWindows(deepest > 0.0, f"on ({where})", deepest)
-    inelastic = config.water.inelastic is not None and bool(config.water.inelastic.processes())
     if config.estimator.mode == "analog":
         return DepthWindows(False, "off (auto: the analog walk)", deepest)
-    if inelastic:
+    if config.water.inelastic is not None and config.water.inelastic.processes():
         return DepthWindows(False, "off (auto: inelastic light)", deepest)
     on = zeta >= AUTO_ATTENUATION_DEPTHS
     return DepthWindows(on, f"{'on' if on else 'off'} (auto: {where}; on from "
