@@ -314,6 +314,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
         from .bench import inelastic
         return inelastic.main(Path(args.output), args.quick)
 
+    if args.deep:
+        from .bench import deep
+        return deep.main(Path(args.output), args.quick)
+
     configs = Path(args.configs)
     if not (configs / "bare_walk.yaml").is_file():
         raise UsageError(f"--configs {configs}: no bare_walk.yaml there (run from the "
@@ -425,6 +429,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="only the inelastic section (DIR/inelastic.md): what Raman "
                             "scattering and chlorophyll fluorescence cost in clear deep water, "
                             "and their parts' time to 1%%")
+    bench.add_argument("--deep", action="store_true",
+                       help="only the deep-light section (DIR/deep.md): depth splitting on a "
+                            "stratified column, time to 1%% per depth with and without")
     bench.add_argument("--sweep", action="store_true",
                        help="only the sweep benchmark (DIR/sweep.md): a 100-point LUT on 1 "
                             "and 2 Dask workers against a plain loop")

@@ -141,3 +141,33 @@ def test_speed_section_alone_writes_speed_report(tmp_path):
     assert "## Speed ceiling" in report and "## Start-up" in report
     assert "Error against run time" not in report
     assert not (tmp_path / "s" / "bench.md").exists()
+
+
+def test_deep_section_reports_gains_and_the_target():
+    """The deep-light section's table: the gain is the time to 1% without windows over the
+    time with; the target is met only if every quantity at every depth down to 10 attenuation
+    depths (and the first level below) reaches 1% within 60 s; a level no light reached shows
+    '-'."""
+    from oceanmc.bench import deep
+
+    def times(ed, eou, lu):
+        return {"photons_per_s": 1000.0, "events_per_photon": 10.0, "depth_splitting": "on",
+                "Ed": ed, "Eou": eou, "Lu": lu, "time_s": 1.0}
+    variant = {"variant": "v", "estimator": {}, "attenuation_depths": [0.0, 9.0, 10.5, 12.0],
+               "off": times([1.0, 50.0, 900.0, float("inf")], [2.0, 60.0, 100.0, 1.0],
+                            [1.0, 1.0, 1.0, 1.0]),
+               "auto": times([2.0, 5.0, 9.0, 70.0], [4.0, 30.0, 59.0, 99.0],
+                             [1.0, 1.0, 1.0, 1.0])}
+    spread = {"seeds": 12, "photons": 10, "ratio_one_depth_sd": 0.21, **{
+        q: {"rms_z": 1.0, "max_abs_z": 2.0, "ratio_median": 1.0, "ratio_min": 0.8,
+            "ratio_max": 1.2} for q in ("Ed", "Eou", "Lu")}}
+    data = {"photons": 10, "repeats": 1, "depths_m": [0.0, 50.0, 100.0, 120.0],
+            "beam_optical_depths": [0.0, 30.0, 60.0, 80.0], "variants": [variant],
+            "auto_rule": [], "shipped": None, "spread": spread}
+    text = "\n".join(deep.report_lines(data, "abc1234"))
+    assert "| 100 | 10.50 | 60.0 | 900.0 | 9.0 | 100.00x | 100.0 | 59.0 | 1.69x |" in text
+    assert "| 120 | 12.00 | 80.0 | - | 70.0 | - |" in text
+    assert "without windows: **not met**; the worst is Ed at 100 m, 900 s." in text
+    # 120 m lies past the first level at or below 10 attenuation depths: not counted
+    assert "with windows: **met**; the worst is Eou at 100 m, 59 s." in text
+    assert "Kernel commit abc1234." in text

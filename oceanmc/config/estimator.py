@@ -29,7 +29,13 @@ class Estimator(_Strict):
     uniformly in the cone of half-angle upward_cone_deg around straight up (in a layer of
     single-scattering albedo w0 the fraction is min(upward_fraction, 1 - w0)); for Lu,
     Lw_nadir and Rrs_nadir. auto (the default): AUTO_UPWARD_FRACTION in a spectral scene of
-    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py)."""
+    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py).
+    depth_splitting: depth importance weight windows (scene/weight_window.py): packets are
+    split as they go deeper and play roulette as they come up, so that light is followed as
+    well at the deepest tally depth as near the surface. auto (the default): on in an implicit
+    walk without inelastic light whose deepest tally depth lies at least
+    scene.weight_window.AUTO_ATTENUATION_DEPTHS attenuation depths down; on: whenever the
+    tallies go below the surface (not with inelastic light); off: never."""
     mode: Literal["implicit", "analog"] = "implicit"
     roulette_weight: Annotated[float, Field(gt=0.0, lt=1.0, allow_inf_nan=False)] = 1e-3
     roulette_survival: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = 0.1
@@ -47,6 +53,7 @@ class Estimator(_Strict):
     # reference the carried light is checked against: validation case inelastic). The default
     # measured best for the inelastic parts of Rrs (benchmarks/inelastic.md)
     emitted_light: Literal["carried", "packets"] = "carried"
+    depth_splitting: Literal["auto", "on", "off"] = "auto"
     # the least weight of an emitted packet (emitted_light packets, the analog walk); lighter
     # emissions are made with probability weight / emission_weight and carry emission_weight
     # (kernel/channels/inelastic.py); measured best for packets in clear water
@@ -61,3 +68,13 @@ class Estimator(_Strict):
             raise ValueError(f"allowed: {MIN_EMISSION_WEIGHT:g} .. 1 (an emitted packet's "
                              "spectral weights divide by it)")
         return weight
+
+    @field_validator("depth_splitting", mode="before")
+    @classmethod
+    def _yaml_switch(cls, value):
+        # YAML 1.1 reads a bare on / off as true / false
+        if value is True:
+            return "on"
+        if value is False:
+            return "off"
+        return value

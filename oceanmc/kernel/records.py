@@ -149,13 +149,19 @@ ESTIMATES = _record(
     floats_at=("dirs", "air_factor", "cap_m0w", "cap_m1w", "cap_m0a", "cap_m1a", "level_decay"),
     ints_at=("in_water", "table_of_layer"))
 
-# How weights evolve (kernel/transport.py).
+# How weights evolve (kernel/transport.py), one row per segment of the water column (between
+# its planes, MEDIUM plane_z): the rows differ only where depth windows change them
+# (kernel/weight_window.py, scene/weight_window.py).
 # emission_weight: the least weight of a packet an inelastic process emits (lighter emissions
 # play roulette up to it); carry_emissions: the packet that emits light carries it on
-# (kernel/channels/inelastic.py)
+# (kernel/channels/inelastic.py); depth_windows: packets are split on entering a segment whose
+# window weight `window` they exceed (never with inelastic light); roulette_weight: the
+# roulette threshold at collisions in the segment (the configured one times the window)
 ESTIMATOR = _record("analog", "roulette_weight", "roulette_survival", "max_events",
                     "split_weight", "splitting", "upward", "emission_weight", "carry_emissions",
-                    ints=("analog", "max_events", "splitting", "upward", "carry_emissions"))
+                    "depth_windows", "window",
+                    ints=("analog", "max_events", "splitting", "upward", "carry_emissions",
+                          "depth_windows"))
 
 # A photon packet: position (depth z and the segment it is in or on), weight, direction of
 # travel, whether it still belongs to the collimated solar beam, its wavelength's index (in

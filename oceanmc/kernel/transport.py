@@ -18,10 +18,13 @@ and multiplies its weight by the single-scattering albedo), expected values at t
 light from the water: the leaving part w (1 - R) is scored, and the packet goes on, reflected,
 with probability R and weight w), weight times rho_dh at the bottom, exact exponential
 attenuation in layers that do not scatter, and unbiased Russian roulette below
-roulette_weight; optionally, scattering biased toward straight up (upward.py) and splitting of
-heavy packets. Analog mode decides each of these with a random draw instead (in a spectral walk,
-for the hero wavelength; kernel/spectral.py). Either way every
-quantity has the same expectation; only the variance differs.
+roulette_weight; optionally, scattering biased toward straight up (upward.py), splitting of
+heavy packets, and depth importance windows (weight_window.py: on entering a segment of the
+column a packet is split above the segment's window weight, and the roulette threshold at
+collisions is scaled by it: the estimator record ctrl of an event is its segment's row).
+Analog mode decides each of these with a random draw instead (in a spectral walk, for the hero
+wavelength; kernel/spectral.py). Either way every quantity has the same expectation; only the
+variance differs.
 
 A spectral scene traces all its wavelengths in one history (kernel/spectral.py): a hero
 wavelength per photon (p.wavelength) samples the path, and every wavelength's weight follows it;
@@ -33,7 +36,7 @@ kept apart from the packet, so split copies do not copy it. One event's scratch 
 """
 import math
 
-from . import local_estimate, packet, spectral
+from . import local_estimate, packet, spectral, weight_window
 from .brdf import dispatch as brdf
 from .channels import dispatch as channels
 from .compile import batch, internal
@@ -72,14 +75,13 @@ def survives_roulette(ctrl, p, rng):
 
 
 @internal
-def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
-    """Splitting by weight: a packet heavier than split_weight becomes k = floor(w /
-    split_weight) + 1 packets of weight w / k, each lighter than split_weight, that go on
-    independently from the same state (the walk has no memory, so each is an unbiased copy;
-    Kalos & Whitlock, Monte Carlo Methods, 2008, 4.2). All but one wait on the stack, as many as
-    it has room for (fewer, heavier copies are as unbiased); every copy carries the packet's
-    spectral state. Returns the new stack height."""
-    copies = min(int(p.w / ctrl.split_weight) + 1, stack.shape[0] - n_stacked + 1)
+def split_into(grid, stack, stack_ps, n_stacked, p, ps, copies):
+    """The packet becomes `copies` packets of weight w / copies that go on independently from
+    the same state (the walk has no memory, so each is an unbiased copy; Kalos & Whitlock,
+    Monte Carlo Methods, 2008, 4.2). All but one wait on the stack, as many as it has room for
+    (fewer, heavier copies are as unbiased); every copy carries the packet's spectral state.
+    Returns the new stack height."""
+    copies = min(copies, stack.shape[0] - n_stacked + 1)
     if copies <= 1:
         return n_stacked
     packet.divide(grid, p, ps, copies)
@@ -87,6 +89,14 @@ def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
         packet.copy(grid, stack[n_stacked], stack_ps[n_stacked], p, ps)
         n_stacked += 1
     return n_stacked
+
+
+@internal
+def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
+    """Splitting by weight: a packet heavier than split_weight becomes k = floor(w /
+    split_weight) + 1 packets of weight w / k, each lighter than split_weight (split_into).
+    Returns the new stack height."""
+    return split_into(grid, stack, stack_ps, n_stacked, p, ps, int(p.w / ctrl.split_weight) + 1)
 
 
 @internal
@@ -452,8 +462,8 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                                                   tau, draws)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
-                    alive, tau, n_stacked = collide(medium, surface, ctrl, grid, est, floats,
-                                                    ints, tally, ps, work, stack,
+                    alive, tau, n_stacked = collide(medium, surface, ctrl_row[p.seg], grid,
+                                                    est, floats, ints, tally, ps, work, stack,
                                                     stack_ps, n_stacked, p, where, walk_events,
                                                     draws, rng_emitted)
                 elif outcome == FLIGHT_PLANE:
@@ -464,10 +474,15 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
                                                   floats, ints, bp, tally, ps, work, p, draws)
+                    elif ctrl.depth_windows:
+                        n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
+                                               weight_window.copies(ctrl_row[p.seg], grid, p,
+                                                                    ps))
                     if alive and plane != PLANE_INSIDE:
-                        alive, n_stacked = after_reflection(medium, ctrl, grid, floats, ints,
-                                                            tally, ps, stack, stack_ps,
-                                                            n_stacked, p, level, draws)
+                        alive, n_stacked = after_reflection(medium, ctrl_row[p.seg], grid,
+                                                            floats, ints, tally, ps, stack,
+                                                            stack_ps, n_stacked, p, level,
+                                                            draws)
                 else:
                     alive = False
             events += walk_events

@@ -282,6 +282,8 @@ def run_attrs(run: PreparedRun, batches: Batches, done: int, threads: int, wall:
         # illumination's Ed0 and diffuse_fraction, or its spectrum model or table)
         "illumination_Ed0": np.asarray(facts.ed0, dtype=np.float64),
         "illumination_diffuse_fraction": np.asarray(facts.diffuse, dtype=np.float64),
+        # estimator.depth_splitting as decided for the scene, and why (scene/weight_window.py)
+        "depth_splitting": run.scene.depth_splitting,
     }
     if facts.inelastic:
         # the outputs' parts (derivation.add_parts), and the wavelengths traced for the

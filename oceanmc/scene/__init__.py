@@ -11,7 +11,7 @@ import numpy as np
 from .. import config as cfg
 from .. import optics
 from ..kernel.records import ESTIMATOR, SPLIT_STACK_ROWS, merge, record
-from . import bottom, estimates, grid, medium, sky, surface
+from . import bottom, estimates, grid, medium, sky, surface, weight_window
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
 
@@ -35,6 +35,8 @@ class Scene:
     # (n_wl,) the bottom's reflectance at each wavelength (optics/bottom.py; a mixture's
     # fraction-weighted), None for a bottom without one (black, ggx, hapke, table, ...)
     bottom_reflectance: np.ndarray | None = None
+    # estimator.depth_splitting as decided for the scene, and why (weight_window.choose)
+    depth_splitting: str = "off"
 
     def kernel_args(self) -> tuple:
         return (self.medium, self.surface, self.bottom, self.sky, self.grid, self.estimates,
@@ -49,21 +51,32 @@ class Scene:
     def stack_rows(self) -> int:
         """Rows of the stack that split copies and emitted packets wait on (one, unused,
         without either)."""
-        uses = self.estimator[0]["splitting"] or self.medium[0]["n_channels"] > 1
+        ctrl = self.estimator[0]
+        uses = ctrl["splitting"] or ctrl["depth_windows"] or self.medium[0]["n_channels"] > 1
         return SPLIT_STACK_ROWS if uses else 1
 
 
-def pack_estimator(est: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
-    upward = medium.upward_fractions(est, albedo)
-    return record(ESTIMATOR, analog=int(est.mode == "analog"),
-                  roulette_weight=float(est.roulette_weight),
-                  roulette_survival=float(est.roulette_survival),
-                  max_events=int(est.max_events),
-                  split_weight=float(est.split_weight or np.inf),
-                  splitting=int(est.split_weight is not None),
-                  upward=int(upward.max(initial=0.0) > 0.0),
-                  emission_weight=float(est.emission_weight),
-                  carry_emissions=int(est.emitted_light == "carried"))
+def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:
+    """The ESTIMATOR records, one per segment of the column: under depth windows each holds its
+    segment's window weight W and the roulette threshold at collisions there, max(roulette_weight,
+    weight_window.ROULETTE_WEIGHT) x W (scene/weight_window.py)."""
+    upward = medium.upward_fractions(est, column.albedo)
+    rows = np.repeat(record(ESTIMATOR, analog=int(est.mode == "analog"),
+                            roulette_weight=float(est.roulette_weight),
+                            roulette_survival=float(est.roulette_survival),
+                            max_events=int(est.max_events),
+                            split_weight=float(est.split_weight or np.inf),
+                            splitting=int(est.split_weight is not None),
+                            upward=int(upward.max(initial=0.0) > 0.0),
+                            emission_weight=float(est.emission_weight),
+                            carry_emissions=int(est.emitted_light == "carried"),
+                            depth_windows=int(column.windows.on), window=1.0),
+                     len(column.window))
+    if column.windows.on:
+        rows["window"] = column.window
+        rows["roulette_weight"] = max(est.roulette_weight, weight_window.ROULETTE_WEIGHT) * \
+            column.window
+    return rows
 
 
 def build(config: cfg.SceneConfig,
@@ -89,9 +102,9 @@ def build(config: cfg.SceneConfig,
     (med, bot, sk, gr, est, surf), floats, ints = merge(
         [(med, mf, mi), (bot, bp, no_ints), (sk, sf, no_ints), (gr, gf, gi), (est, ef, ei),
          (surf, surface.pool(config.surface, surf), no_ints)])
-    return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column.albedo),
+    return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column),
                  floats, ints, angles, local_rows, column.layers,
-                 optics.bottom_spectrum(config.bottom, config.wavelengths))
+                 optics.bottom_spectrum(config.bottom, config.wavelengths), column.windows.why)
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]

@@ -12,7 +12,7 @@ from .. import config as cfg
 from .. import optics, registry
 from ..kernel import models, spectral
 from ..kernel.records import MEDIUM, Pool, record
-from . import phase_tables
+from . import phase_tables, weight_window
 
 PURE_WATER_BETA = 0.835   # 0.06225 (1 + 0.835 cos^2): Morel (1974)
 RAYLEIGH_BETA = 1.0
@@ -27,6 +27,8 @@ class Column:
     albedo: np.ndarray         # per layer
     layers: tuple              # optics.LayerIOPs of each layer (a depth profile is resolved
     #                            into several layers of one configured layer)
+    windows: weight_window.DepthWindows   # depth splitting: whether, and why
+    window: np.ndarray         # the window weight of each segment between planes (1: none)
 
 
 def _mixture(phase: cfg.Mixture) -> list:
@@ -61,10 +63,11 @@ def phase_components(phase) -> list[tuple[float, int, list[float], tuple | None]
     return COMPONENTS[phase.model](phase)
 
 
-def planes(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]):
+def planes(config: cfg.SceneConfig, layers: list[optics.LayerIOPs], added=()):
     """Plane depths (surface first, bottom or inf last), the tally level at each plane (-1 for
     none), the layer of each segment between planes, the level tallied at 0- (or -1), and the
-    tally depths (snapped onto layer boundaries they differ from only by rounding)."""
+    tally depths (snapped onto layer boundaries they differ from only by rounding). added:
+    depths of further planes without a tally (the depth windows': weight_window.py)."""
     bounds = [0.0]
     for layer in layers:
         bounds.append(bounds[-1] + layer.thickness_m)
@@ -75,7 +78,8 @@ def planes(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]):
     for d in config.tallies.depths_m:
         near = int(np.argmin(np.abs(edges - d)))
         depths.append(bounds[near] if abs(edges[near] - d) <= 1e-9 * max(1.0, d) else d)
-    plane_z = np.array(sorted(set(bounds) | set(depths)), dtype=np.float64)
+    plane_z = np.array(sorted(set(bounds) | set(depths) | set(map(float, added))),
+                       dtype=np.float64)
     level_of = {d: i for i, d in enumerate(depths)}
     plane_tally = np.array([level_of.get(z, -1) for z in plane_z], dtype=np.int64)
     tops = np.array(bounds[:-1])
@@ -254,6 +258,11 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         share, comp_start, comp_count, layer_b, comp_model, comp_tables)
 
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
+    windows = weight_window.choose(config, layers)
+    added = weight_window.added_planes(windows, layers, plane_z)
+    if added.size:
+        plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers,
+                                                                            added)
     layer_c = np.array([layer.c for layer in layers], dtype=np.float64)       # (n_layers, n_wl)
     albedo_all = np.divide(layer_b, layer_c, out=np.zeros_like(layer_c), where=layer_b > 0.0)
     albedo = albedo_all.max(axis=1)
@@ -301,5 +310,6 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         channel_transfer=f.add([ch.transfer for ch in inelastic]),
         channel_band=i.add([optics.inelastic.band(ch.transfer) for ch in inelastic]),
         channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]))
-    column = Column(surface_level, depths, level_tau, albedo, tuple(layers))
+    column = Column(surface_level, depths, level_tau, albedo, tuple(layers), windows,
+                    weight_window.segment_windows(windows, layers, plane_z))
     return rec, f.array(), i.array(), column
