@@ -41,3 +41,32 @@ def z_of(value, stderr, reference):
     exact = np.abs(diff) <= 1e-9
     safe = np.where(stderr > 0.0, stderr, 1.0)
     return np.where(stderr > 0.0, diff / safe, np.where(exact, 0.0, np.inf))
+
+
+def assert_budgets_close(result, sources: dict, z_max: float) -> dict:
+    """Each part's budget total equals its source (elastic 1, an inelastic part 0) within
+    z_max standard errors, or to 1e-9 where it has no noise; returns each part's max |z|."""
+    worst = {}
+    for part, source in sources.items():
+        total = result[f"{part}/budget/total"]
+        se = result.stderr(f"{part}/budget/total")
+        z = z_of(total, se, source)
+        worst[part] = float(np.abs(z).max())
+        ok = (np.abs(total - source) <= z_max * se) | (np.abs(total - source) <= 1e-9)
+        assert ok.all(), (part, z)
+    return worst
+
+
+def assert_estimates_agree(result, reference, quantities, z_max: float) -> dict:
+    """Two independent estimates of each quantity agree within |z| < z_max (both standard
+    errors) wherever the reference is lit (above 1e-3 of its largest value); returns each
+    quantity's max |z|."""
+    worst = {}
+    for quantity in quantities:
+        expected = reference[quantity]
+        lit = np.abs(expected) > 1e-3 * np.abs(expected).max()
+        z = z_of(result[quantity] - expected,
+                 np.hypot(result.stderr(quantity), reference.stderr(quantity)), 0.0)[lit]
+        worst[quantity] = float(np.abs(z).max())
+        assert (np.abs(z) < z_max).all(), (quantity, z)
+    return worst

@@ -36,7 +36,8 @@ from oceanmc.optics.inelastic import channels, transfer
 from oceanmc.run.derivation import PART_DESCRIPTIONS
 from oceanmc.run.results import PART_LABELS, format_summary
 
-from inelastic_helpers import hat_integral, trapezoid_weights, z_of
+from inelastic_helpers import (assert_budgets_close, assert_estimates_agree, hat_integral,
+                               trapezoid_weights, z_of)
 
 Z_MAX = 5.0
 SEED = 20251126
@@ -265,14 +266,7 @@ def test_cdom_part_with_standard_errors(whole, tmp_path):
 
 
 def test_every_part_budget_closes(whole):
-    worst = {}
-    for part, source in (("elastic", 1.0), ("cdom_fluorescence", 0.0)):
-        total = whole[f"{part}/budget/total"]
-        se = whole.stderr(f"{part}/budget/total")
-        z = z_of(total, se, source)
-        worst[part] = float(np.abs(z).max())
-        ok = (np.abs(total - source) <= Z_MAX * se) | (np.abs(total - source) <= 1e-9)
-        assert ok.all(), (part, z)
+    worst = assert_budgets_close(whole, {"elastic": 1.0, "cdom_fluorescence": 0.0}, Z_MAX)
     assert whole["cdom_fluorescence/budget/shifted_in"].sum() > 0.0
     print("budget closure max |z|:", worst)
 
@@ -298,13 +292,8 @@ def test_elastic_part_is_the_run_without_it(packets, whole, elastic_only):
 
 def test_carried_light_agrees_with_emitted_packets(whole, packets):
     """Two estimators of the CDOM part, independent draws: |z| < Z_MAX where it is lit."""
-    for name in ("air/Rrs_nadir", "Ed", "Eu", "budget/shifted_in"):
-        quantity = f"cdom_fluorescence/{name}"
-        reference = packets[quantity]
-        lit = np.abs(reference) > 1e-3 * np.abs(reference).max()
-        z = z_of(whole[quantity] - reference,
-                 np.hypot(whole.stderr(quantity), packets.stderr(quantity)), 0.0)[lit]
-        assert (np.abs(z) < Z_MAX).all(), (quantity, z)
+    assert_estimates_agree(whole, packets, [f"cdom_fluorescence/{name}" for name in (
+        "air/Rrs_nadir", "Ed", "Eu", "budget/shifted_in")], Z_MAX)
 
 
 def test_take_is_yield_times_cdom_absorption(whole, packed):

@@ -36,7 +36,8 @@ from oceanmc.optics.inelastic import chlorophyll_fluorescence as fluorescence
 from oceanmc.optics.inelastic import raman
 from oceanmc.validation.cases.inelastic import clear_water
 
-from inelastic_helpers import hat_integral, trapezoid_weights, z_of
+from inelastic_helpers import (assert_budgets_close, assert_estimates_agree, hat_integral,
+                               trapezoid_weights, z_of)
 
 Z_MAX = 5.0
 PHOTONS = 30_000
@@ -411,14 +412,8 @@ def test_inelastic_light_where_expected(whole):
 
 
 def test_every_part_budget_closes(whole):
-    worst = {}
-    for part, source in (("elastic", 1.0), ("raman", 0.0), ("chlorophyll_fluorescence", 0.0)):
-        total = whole[f"{part}/budget/total"]
-        se = whole.stderr(f"{part}/budget/total")
-        z = z_of(total, se, source)
-        worst[part] = float(np.abs(z).max())
-        ok = (np.abs(total - source) <= Z_MAX * se) | (np.abs(total - source) <= 1e-9)
-        assert ok.all(), (part, z)
+    worst = assert_budgets_close(whole, {"elastic": 1.0, "raman": 0.0,
+                                         "chlorophyll_fluorescence": 0.0}, Z_MAX)
     print("budget closure max |z|:", worst)
     # the elastic part gives nothing to itself; the inelastic parts receive what was emitted
     assert (whole["elastic/budget/shifted_in"] == 0.0).all()
@@ -503,16 +498,10 @@ def test_carried_light_agrees_with_emitted_packets(whole, packets):
     """Two estimators of each inelastic part, independent draws: the light carried on by the
     emitting packet, and a packet of its own per emission; |z| < Z_MAX wherever the part is
     lit (above 1e-3 of its largest value)."""
-    worst = {}
-    for part in ("raman", "chlorophyll_fluorescence"):
-        for name in ("air/Rrs_nadir", "Ed", "Eu", "Eou", "budget/shifted_in"):
-            quantity = f"{part}/{name}"
-            reference = packets[quantity]
-            lit = np.abs(reference) > 1e-3 * np.abs(reference).max()
-            z = z_of(whole[quantity] - reference,
-                     np.hypot(whole.stderr(quantity), packets.stderr(quantity)), 0.0)[lit]
-            worst[quantity] = float(np.abs(z).max())
-            assert (np.abs(z) < Z_MAX).all(), (quantity, z)
+    worst = assert_estimates_agree(
+        whole, packets, [f"{part}/{name}" for part in ("raman", "chlorophyll_fluorescence")
+                         for name in ("air/Rrs_nadir", "Ed", "Eu", "Eou", "budget/shifted_in")],
+        Z_MAX)
     print("carried vs emitted packets, max |z|:", worst)
 
 
