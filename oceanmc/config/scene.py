@@ -133,8 +133,9 @@ class SceneConfig(_Strict):
         inelastic = self.water.inelastic is not None and bool(self.water.inelastic.processes())
         if self.estimator.depth_splitting == "on" and inelastic:
             raise ValueError("estimator.depth_splitting = 'on' with water.inelastic: the depth "
-                             "windows follow the elastic light, and would roulette the light "
-                             "that inelastic processes emit; use 'auto' (off here) or 'off'")
+                             "windows are set by the elastic light's attenuation and have not "
+                             "been checked against the light inelastic processes emit; use "
+                             "'auto' (off here) or 'off'")
         if self.estimator.mode == "analog" and not bottom_weight_bounded(self.bottom):
             raise ValueError(f"estimator.mode = 'analog' with bottom.model = "
                              f"{self.bottom.model!r} sampled by weight f cos/pdf, which can "
