@@ -21,6 +21,9 @@ from .common import Case, _plt, scene
 A440, SLOPE, DEPTH = 0.05, 0.005, 2.0
 EMISSION = np.arange(450.0, 601.0, 25.0)
 BOOSTED_B488 = 2.6e-2      # 100 x water's: Raman light abundant, all orders compared
+PROCESSES = {"raman": {}, "chlorophyll_fluorescence": {}}
+ELASTIC_QUANTITIES = ("Ed", "Eu", "Eo", "Lu", "air/Rrs_nadir", "air/Rrs_nadir_crossing",
+                      "budget/water_leaving")
 
 
 def absorption(wavelengths_nm):
@@ -57,6 +60,29 @@ def clear_water(name: str, photons: int, inelastic: dict | None, seed: int,
     return config
 
 
+def compare_paired(ctx: Ctx, label: str, first, first_quantity: str, second,
+                   second_quantity: str, lit: np.ndarray, grid) -> None:
+    """Two estimates of one quantity, batch by batch (the same run's, or two runs of as many
+    batches, correlated or not): z of each wavelength from the batches' differences, and the
+    joint test
+    Hotelling's T^2 with their leave-one-batch-out covariance (the wavelengths of a run share
+    its photons: a chi-square of their z would count one deviation many times), on at most
+    batches / 2 - 1 wavelengths spread over the lit ones."""
+    lit = np.flatnonzero(np.ravel(lit))
+    one = first.quantities[first_quantity].batches
+    two = second.quantities[second_quantity].batches
+    n_batches = one.shape[0]
+    most = n_batches // 2 - 1
+    if lit.size > most:
+        lit = lit[np.unique(np.linspace(0, lit.size - 1, most).round().astype(int))]
+    difference = (one.reshape(n_batches, -1) - two.reshape(n_batches, -1))[:, lit]
+    stderr = difference.std(axis=0, ddof=1) / np.sqrt(n_batches)
+    loo = (difference.sum(axis=0) - difference) / (n_batches - 1)
+    labels = [f"{w:g} nm" for w in np.asarray(grid)[np.unravel_index(lit, one.shape[1:])[0]]]
+    ctx.compare(label, one.mean(axis=0).ravel()[lit], stderr, two.mean(axis=0).ravel()[lit],
+                labels=labels, loo=loo)
+
+
 def at(result, wavelengths) -> np.ndarray:
     grid = result.coords["wavelength"]
     return np.array([int(np.argmin(np.abs(grid - w))) for w in wavelengths])
@@ -64,8 +90,9 @@ def at(result, wavelengths) -> np.ndarray:
 
 def case_inelastic(ctx: Ctx) -> None:
     compare_thin_layer(ctx)
-    elastic, whole = compare_elastic_part(ctx)
+    elastic, whole, seed = compare_elastic_part(ctx)
     check_fluorescence(ctx)
+    compare_packets(ctx, whole, elastic, seed)
     check_closure(ctx, whole)
     plot(ctx, whole)
     ctx.note(
@@ -131,47 +158,28 @@ def compare_thin_layer(ctx: Ctx) -> None:
 
 def compare_elastic_part(ctx: Ctx):
     """The elastic part against the same scene without inelastic light (its Raman loss as an
-    absorber, same seed): equal to rounding where each emission is a packet of its own (its
-    draws from a stream of its own), equal within the standard errors where the emitting
-    packet carries the light on (the default: roulette then weighs all the light a packet
-    carries, so the draws part); the carried light against the emitted packets, two
-    estimators of each inelastic part; local against crossing estimates."""
+    absorber, same seed): equal within the standard errors where the emitting packet carries
+    the light on (the default: roulette then weighs all the light a packet carries, so the
+    draws part; equal to rounding with emitted packets, compare_packets); local against
+    crossing estimates of the inelastic parts."""
     photons = ctx.pick(1_000_000, 200_000)
     seed = ctx.next_seed()
-    processes = {"raman": {}, "chlorophyll_fluorescence": {}}
-    whole = ctx.simulate(clear_water("clear water, Raman and fluorescence", photons, processes,
+    whole = ctx.simulate(clear_water("clear water, Raman and fluorescence", photons, PROCESSES,
                                      seed))
-    packets_config = clear_water("clear water, Raman and fluorescence, emitted packets",
-                                 photons, processes, seed)
-    packets_config["estimator"] = {"emitted_light": "packets"}
-    packets = ctx.simulate(packets_config)
     grid = whole.coords["wavelength"]
     elastic = ctx.simulate(clear_water("clear water without inelastic light, Raman loss as "
                                        "absorption", photons, None, seed,
                                        (grid, raman.coefficient_at(Raman(), grid))))
-    for quantity in ("Ed", "Eu", "Eo", "Lu", "air/Rrs_nadir", "air/Rrs_nadir_crossing",
-                     "budget/water_leaving"):
-        ctx.exact(f"clear water, emitted packets: elastic/{quantity} = {quantity} without "
-                  "inelastic light (same seed)", np.ravel(packets[f"elastic/{quantity}"]),
-                  np.ravel(elastic[quantity]), rtol=1e-9, atol=1e-300)
-        ctx.compare(f"clear water, carried: elastic/{quantity} against {quantity} without "
-                    "inelastic light", np.ravel(whole[f"elastic/{quantity}"]),
-                    np.ravel(whole.stderr(f"elastic/{quantity}")), np.ravel(elastic[quantity]),
-                    ref_error=np.ravel(elastic.stderr(quantity)))
-    taken = packets["elastic/budget/absorbed_layer_1"] + packets["elastic/budget/shifted_out"]
-    ctx.exact("clear water, emitted packets: elastic absorbed + shifted out = absorbed "
-              "without inelastic light", taken, elastic["budget/absorbed_layer_1"], rtol=1e-9)
+    for quantity in ELASTIC_QUANTITIES:
+        compare_paired(ctx, f"clear water, carried: elastic/{quantity} against {quantity} "
+                       "without inelastic light (same seed, batch by batch)", whole,
+                       f"elastic/{quantity}", elastic, quantity,
+                       np.ones(np.shape(elastic[quantity]), dtype=bool), grid)
     k = at(whole, [550.0])[0]
     share = whole["raman/air/Rrs_nadir"][k] / whole["air/Rrs_nadir"][k]
     ctx.exact("clear water: Raman share of Rrs(550) within the range reported for clear "
               "ocean water, 0.05-0.25", share, 0.15, atol=0.10)
     for part in ("raman", "chlorophyll_fluorescence"):
-        for quantity in (f"{part}/air/Rrs_nadir", f"{part}/Ed", f"{part}/Eu", f"{part}/Eou"):
-            value, reference = np.ravel(whole[quantity]), np.ravel(packets[quantity])
-            lit = np.abs(reference) > 1e-3 * np.abs(reference).max()
-            ctx.compare(f"clear water: {quantity}, carried on by the emitting packet against "
-                        "emitted packets", value[lit], np.ravel(whole.stderr(quantity))[lit],
-                        reference[lit], ref_error=np.ravel(packets.stderr(quantity))[lit])
         quantity = f"{part}/air/Rrs_nadir"
         crossing = quantity + "_crossing"
         # where the crossing estimate (photons leaving through the 5-degree cap: a handful a
@@ -179,11 +187,43 @@ def compare_elastic_part(ctx: Ctx):
         # from normal and their standard error unreliable (a heavy tail passes short tests)
         lit = (whole[quantity] > 1e-3 * whole[quantity].max()) & (
             whole.stderr(crossing) < 0.2 * np.abs(whole[crossing]))
-        ctx.compare(f"clear water: {quantity}, local estimate against the crossing estimate",
-                    whole[quantity][lit], whole.stderr(quantity)[lit],
-                    whole[crossing][lit], ref_error=whole.stderr(crossing)[lit],
-                    labels=[f"{w:g} nm" for w in grid[lit]])
-    return elastic, whole
+        compare_paired(ctx, f"clear water: {quantity}, local estimate against the crossing "
+                       "estimate", whole, quantity, whole, crossing, lit, grid)
+    return elastic, whole, seed
+
+
+def compare_packets(ctx: Ctx, whole, elastic, seed) -> None:
+    """The same scene with each emission in a packet of its own (same seed; simulated last,
+    so that the case's earlier scenes keep their places in the regression records): its
+    elastic part equals the run without inelastic light to rounding (the emissions draw from
+    a stream of their own), and the carried light agrees with it, two estimators of each
+    inelastic part's Rrs, Ed, Eu and Eou."""
+    config = clear_water("clear water, Raman and fluorescence, emitted packets",
+                         ctx.pick(1_000_000, 200_000), PROCESSES, seed)
+    config["estimator"] = {"emitted_light": "packets"}
+    packets = ctx.simulate(config)
+    for quantity in ELASTIC_QUANTITIES:
+        ctx.exact(f"clear water, emitted packets: elastic/{quantity} = {quantity} without "
+                  "inelastic light (same seed)", np.ravel(packets[f"elastic/{quantity}"]),
+                  np.ravel(elastic[quantity]), rtol=1e-9, atol=1e-300)
+    taken = packets["elastic/budget/absorbed_layer_1"] + packets["elastic/budget/shifted_out"]
+    ctx.exact("clear water, emitted packets: elastic absorbed + shifted out = absorbed "
+              "without inelastic light", taken, elastic["budget/absorbed_layer_1"], rtol=1e-9)
+    grid = whole.coords["wavelength"]
+    for part in ("raman", "chlorophyll_fluorescence"):
+        for quantity in (f"{part}/air/Rrs_nadir", f"{part}/Ed", f"{part}/Eu", f"{part}/Eou"):
+            # at the first tally depth (0-) for the irradiances
+            reference = packets[quantity]
+            lit = np.zeros(np.shape(reference), dtype=bool)
+            first = (np.abs(reference) > 1e-3 * np.abs(reference).max()) if reference.ndim == 1 \
+                else (np.abs(reference[:, 0]) > 1e-3 * np.abs(reference[:, 0]).max())
+            if reference.ndim == 1:
+                lit = first
+            else:
+                lit[:, 0] = first
+            compare_paired(ctx, f"clear water: {quantity}, carried on by the emitting packet "
+                           "against emitted packets (same seed, batch by batch)",
+                           whole, quantity, packets, quantity, lit, grid)
 
 
 def check_fluorescence(ctx: Ctx) -> None:
