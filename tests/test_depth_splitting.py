@@ -147,14 +147,19 @@ def test_off_and_idle_windows_change_nothing():
 
 
 def test_auto_rule():
-    """auto: on for a deep implicit scene; off for the analog walk and with inelastic light
-    (where `on` still may be asked for)."""
+    """auto: on for a deep implicit scene; off for the analog walk, in water that does not
+    scatter (the implicit walk is exact there) and with inelastic light (where `on` is
+    refused)."""
     def decided(**changes):
         config = deep("auto", seed=1, photons=64, batches=2, **changes)
         return oceanmc.simulate(config, threads=1).attrs["depth_splitting"]
     assert decided().startswith("on (auto: the deepest tally depth 52 m at 4.")
     assert decided(estimator={"mode": "analog", "upward_fraction": None,
                               "depth_splitting": "auto"}) == "off (auto: the analog walk)"
+    clear = deep("auto", seed=1)
+    for layer in clear["water"]["layers"]:
+        layer.update(b=0.0, phase={"model": "isotropic"})
+    assert decided(water=clear["water"]) == "off (auto: no layer scatters)"
     raman = deep("auto", seed=1, wavelengths_nm=[490.0, 530.0])
     raman["water"]["inelastic"] = {"raman": {}}
     config = oceanmc.load_config(raman)

@@ -33,7 +33,7 @@ class Estimator(_Strict):
     depth_splitting: depth importance weight windows (scene/weight_window.py): packets are
     split as they go deeper and play roulette as they come up, so that light is followed as
     well at the deepest tally depth as near the surface. auto (the default): on in an implicit
-    walk without inelastic light whose deepest tally depth lies at least
+    walk of scattering water without inelastic light whose deepest tally depth lies at least
     scene.weight_window.AUTO_ATTENUATION_DEPTHS attenuation depths down; on: whenever the
     tallies go below the surface (not with inelastic light); off: never."""
     mode: Literal["implicit", "analog"] = "implicit"

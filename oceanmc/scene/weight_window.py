@@ -96,6 +96,10 @@ def choose(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> DepthWind
         return DepthWindows(False, "off (auto: the analog walk)", deepest)
     if config.water.inelastic is not None and config.water.inelastic.processes():
         return DepthWindows(False, "off (auto: inelastic light)", deepest)
+    if not any(layer.b.any() for layer in layers):
+        # an implicit walk through water that does not scatter is exact: copies would only
+        # repeat it
+        return DepthWindows(False, "off (auto: no layer scatters)", deepest)
     on = zeta >= AUTO_ATTENUATION_DEPTHS
     return DepthWindows(on, f"{'on' if on else 'off'} (auto: {where}; on from "
                             f"{AUTO_ATTENUATION_DEPTHS:g})", deepest)
