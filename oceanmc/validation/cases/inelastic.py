@@ -60,27 +60,34 @@ def clear_water(name: str, photons: int, inelastic: dict | None, seed: int,
     return config
 
 
+def compare_batches(ctx: Ctx, label: str, one: np.ndarray, two: np.ndarray, labels) -> None:
+    """Two estimates of the same quantities, batch by batch ((batches, members) each; one run's
+    two estimators, or two runs of as many batches, correlated or not): z of each member from
+    the batches' differences, and the joint test Hotelling's T^2 with their leave-one-batch-out
+    covariance (members of one run share its photons: a chi-square of their z would count one
+    deviation many times), on at most batches / 2 - 1 members spread over them."""
+    n_batches, members = one.shape
+    picked = np.arange(members)
+    if members > n_batches // 2 - 1:
+        picked = np.unique(np.linspace(0, members - 1, n_batches // 2 - 1).round().astype(int))
+    difference = (one - two)[:, picked]
+    ctx.compare(label, one.mean(axis=0)[picked],
+                difference.std(axis=0, ddof=1) / np.sqrt(n_batches), two.mean(axis=0)[picked],
+                labels=[labels[i] for i in picked],
+                loo=(difference.sum(axis=0) - difference) / (n_batches - 1))
+
+
 def compare_paired(ctx: Ctx, label: str, first, first_quantity: str, second,
                    second_quantity: str, lit: np.ndarray, grid) -> None:
-    """Two estimates of one quantity, batch by batch (the same run's, or two runs of as many
-    batches, correlated or not): z of each wavelength from the batches' differences, and the
-    joint test
-    Hotelling's T^2 with their leave-one-batch-out covariance (the wavelengths of a run share
-    its photons: a chi-square of their z would count one deviation many times), on at most
-    batches / 2 - 1 wavelengths spread over the lit ones."""
+    """compare_batches of a quantity of two results at its lit elements, labelled by their
+    wavelengths."""
     lit = np.flatnonzero(np.ravel(lit))
     one = first.quantities[first_quantity].batches
     two = second.quantities[second_quantity].batches
     n_batches = one.shape[0]
-    most = n_batches // 2 - 1
-    if lit.size > most:
-        lit = lit[np.unique(np.linspace(0, lit.size - 1, most).round().astype(int))]
-    difference = (one.reshape(n_batches, -1) - two.reshape(n_batches, -1))[:, lit]
-    stderr = difference.std(axis=0, ddof=1) / np.sqrt(n_batches)
-    loo = (difference.sum(axis=0) - difference) / (n_batches - 1)
     labels = [f"{w:g} nm" for w in np.asarray(grid)[np.unravel_index(lit, one.shape[1:])[0]]]
-    ctx.compare(label, one.mean(axis=0).ravel()[lit], stderr, two.mean(axis=0).ravel()[lit],
-                labels=labels, loo=loo)
+    compare_batches(ctx, label, one.reshape(n_batches, -1)[:, lit],
+                    two.reshape(n_batches, -1)[:, lit], labels)
 
 
 def at(result, wavelengths) -> np.ndarray:
@@ -243,12 +250,9 @@ def check_fluorescence(ctx: Ctx) -> None:
     out = q["elastic/budget/shifted_out"].batches[:, inside]
     absorbed = q["elastic/budget/absorbed_layer_1"].batches[:, inside] + out
     expected = settings.quantum_yield * (layer.a_phytoplankton / layer.a)[inside] * absorbed
-    difference = out - expected
-    n = difference.shape[0]
-    ctx.compare("Chl 1: fluorescence's take = yield x a_ph / a x absorbed, per excitation "
-                "wavelength (difference of two estimators)", difference.mean(axis=0),
-                difference.std(axis=0, ddof=1) / np.sqrt(n), 0.0,
-                labels=[f"{w:g} nm" for w in grid[inside]])
+    compare_batches(ctx, "Chl 1: fluorescence's take = yield x a_ph / a x absorbed, per "
+                    "excitation wavelength (two estimators, batch by batch)", out, expected,
+                    [f"{w:g} nm" for w in grid[inside]])
 
 
 def check_closure(ctx: Ctx, whole) -> None:
