@@ -583,3 +583,12 @@ def test_tiny_quantities_keep_their_standard_errors():
     batches = result.quantities["Eu"].batches * 1e200
     np.testing.assert_allclose(result.stderr("Eu") * 1e200,
                                batches.std(axis=0, ddof=1) / np.sqrt(4), rtol=1e-12)
+
+
+def test_carried_inelastic_light_over_a_1e_minus_308_bottom_stays_finite(scenes):
+    """bottom.reflectance 1e-308 in the inelastic template gave NaN once the emitting packet
+    carried the emitted light on (1 / p.w overflowed); such light is now left out."""
+    scene = copy.deepcopy(scenes["inelastic"])
+    scene["bottom"] = {"model": "lambertian", "reflectance": 1e-308}
+    result = oceanmc.simulate(load_config(scene).model_copy(update=TINY_RUN), threads=1)
+    assert not finite(result)

@@ -173,6 +173,9 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     return n_stacked + 1
 
 
+CARRY_FLOOR = 1e-300
+
+
 @internal
 def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density):
     """The emissions of a collision (each channel's row of the scratch, emit) ride on in packet
@@ -183,7 +186,11 @@ def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)
     collision's implicit capture is booked with the shares it had; then each wavelength's
     shares take the new light in."""
     spectral.settle(medium, floats, grid, tally_row, ps, p, layer)
-    if p.w <= 0.0 or density <= 0.0:
+    # the emission is in the units of p.w (times the packet's G); one below CARRY_FLOOR (after
+    # a bottom of reflectance 1e-308, say) would overflow 1 / p.w into inf x 0 = NaN, and its
+    # light is nothing beside the others': left out, as absorbed light (the emitting part's
+    # take stays booked as shifted out)
+    if p.w < CARRY_FLOOR or density <= 0.0:
         return
     n = grid.n_wl
     _, g, last, share = packet.weights(grid, ps)
