@@ -185,3 +185,26 @@ def test_bad_switch_is_one_clear_error(value):
     message = str(caught.value)
     assert "estimator.depth_splitting" in message and "'auto'" in message \
         and "'off'" in message and "\n" not in message, message
+
+
+def test_windows_in_turbid_weakly_absorbing_water_do_not_flood_the_walk():
+    """Where backscattering dominates absorption the light falls far slower than Gordon's
+    (a + b_b) / 0.75 (b = 1000 1/m, a = 0.1 1/m over 1 m: K 31 1/m by Gordon, the measured
+    ln(Ed(0)/Ed(1 m)) 7.8): the window takes diffusion theory's sqrt(3 a (a + b_b)) there
+    (scene/weight_window.py), so that the copies stay few. Before, every packet was split
+    into e^15 copies and 200 photons ran for more than 20 minutes; now the walk takes 1.5
+    times the plain walk's events per photon (measured: 6,435 against 4,162)."""
+    def run(mode):
+        scene = {"photons": 400, "batches": 4, "seed": 5,
+                 "illumination": {"sun_zenith_deg": 30.0, "diffuse_fraction": 0.2},
+                 "surface": {"model": "flat"},
+                 "water": {"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 1000.0,
+                                       "phase": {"model": "henyey_greenstein", "g": 0.9}}]},
+                 "bottom": {"model": "lambertian", "reflectance": 0.3},
+                 "tallies": {"depths_m": [0.0, 1.0], "radiance": False},
+                 "estimator": {"depth_splitting": mode}}
+        return oceanmc.simulate(scene, threads=1).attrs
+    windows, plain = run("on"), run("off")
+    assert windows["depth_splitting"].startswith("on")
+    assert windows["scattering_events"] < 3 * plain["scattering_events"], \
+        (windows["scattering_events"], plain["scattering_events"])
