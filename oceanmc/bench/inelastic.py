@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy import stats
 
 from ..run.simulation import simulate
 from .report import run_section
@@ -103,7 +104,39 @@ def measure(quick: bool, say) -> dict:
                      "rows": {row: {"value": v, "rel": e,
                                     "time_to_target_s": t * (e / TARGET_REL) ** 2}
                               for row, (v, e) in errors[label].items()}})
-    return {"photons": photons, "repeats": repeats, "runs": runs}
+    return {"photons": photons, "repeats": repeats, "runs": runs,
+            "spread": spread(quick, say)}
+
+
+# the carried light's standard errors against the spread of repeated runs (DESIGN 7.6): each
+# mode SPREAD_RUNS times, independent seeds, SPREAD_PHOTONS photons each
+SPREAD_RUNS = 16
+SPREAD_PHOTONS = 20_000
+SPREAD_MODES = (("carried", None), ("packets", {"emitted_light": "packets"}))
+
+
+def spread(quick: bool, say) -> list[dict]:
+    """Per mode and row: the rms of the runs' batch standard errors over the standard deviation
+    of their means, with its 95% interval from the chi-square law of the sample variance."""
+    n_runs = 4 if quick else SPREAD_RUNS
+    photons = 2_000 if quick else SPREAD_PHOTONS
+    out = []
+    for mode, estimator in SPREAD_MODES:
+        say(f"  spread of {n_runs} repeated runs, {mode}")
+        rows: dict = {}
+        for r in range(n_runs):
+            _, found = _run(scene(photons, 1000 + r, PROCESSES, estimator))
+            for label, (value, rel) in found.items():
+                rows.setdefault(label, []).append((value, rel * abs(value)))
+        for label, pairs in rows.items():
+            values, stderrs = np.array(pairs).T
+            ratio = float(np.sqrt(np.mean(stderrs ** 2)) / np.std(values, ddof=1))
+            dof = n_runs - 1
+            # s^2 dof / sigma^2 ~ chi2(dof): the interval of sigma / s
+            low, high = np.sqrt(stats.chi2.ppf([0.025, 0.975], dof) / dof)
+            out.append({"mode": mode, "row": label, "runs": n_runs, "photons": photons,
+                        "ratio": ratio, "low": ratio * float(low), "high": ratio * float(high)})
+    return out
 
 
 def main(out_dir: Path, quick: bool) -> int:
@@ -157,5 +190,13 @@ def report_lines(data: dict, commit: str) -> list[str]:
                      f"(the default): {carried_t:,.1f} s; with a packet of its own per emission "
                      f"(emitted_light: packets): {packets_t:,.1f} s ({packets_t / carried_t:.1f}x "
                      "longer).")
+    lines += ["", "Standard errors against the spread of repeated runs (each run's batch standard "
+              "error against the standard deviation of the runs' means; 1 when the error bars "
+              "are right; the interval is 95% from the sample variance's chi-square law):", "",
+              "| emitted light | quantity | runs x photons | rms std. error / spread | 95% "
+              "interval |", "|---|---|---|---|---|"]
+    for row in data.get("spread", ()):
+        lines.append(f"| {row['mode']} | {row['row']} | {row['runs']} x {row['photons']:,} | "
+                     f"{row['ratio']:.2f} | {row['low']:.2f}-{row['high']:.2f} |")
     lines.append("")
     return lines
