@@ -8,10 +8,19 @@ Ctrl-C (KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
 
 Numba compiles one function at a time, so on a machine with two or more cores the photon
 loop's events are compiled in two processes that meet in the disk cache: a child process
-compiles the bottom event (the BRDFs, and the local estimates at the bottom: 40% of the work)
-while this one compiles the events in the water and at the surface; trace_batch, compiled last,
-then loads the child's part from the cache (measured: 14.5 s of compilation become about 9).
-If the child fails or is slow, trace_batch compiles that part itself: the result is the same.
+compiles the events at the surface and the bottom (the rough sea's facet walk, the BRDFs, the
+local estimates from the bottom) while this one compiles the collision (the phase functions,
+the inelastic channels, the local estimates from a collision); trace_batch, compiled last,
+then loads the child's part from the cache. If the child fails or is slow, trace_batch
+compiles that part itself: the result is the same. trace_batch's own compilation is the
+longest single step and cannot be shared out: Numba links every callee's optimised LLVM IR into
+the entry point's module, then optimises it again (7.7 s, LLVM's pass timings) and generates
+machine code for all of it (4.8 s), after each callee did the same for its own. Measured one
+after the other in one process (2 cores, a CI run beside it): the collision 13.1 s, the surface
+events 4.6 s, the bottom 5.0 s, trace_batch 11.7 s. The collision alone here and the surface
+events beside the bottom in the child (before: collision and surface here, 16.3 s, against
+8.8 s there) took a cold `oceanmc run configs/default.yaml` from 27.6-29.7 s (kernel 23.9-25.2
+s) to 25.4-28.5 s (kernel 21.9-23.5 s), quiet machine, interleaved runs.
 """
 from __future__ import annotations
 
@@ -78,12 +87,13 @@ def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
 
 
 def parts() -> dict[str, list[tuple]]:
-    """(dispatcher, argument types) to compile, in order: `bottom` (in the child process when
-    there is one), `water` and `entry` (the entry points, trace_batch first) here."""
+    """(dispatcher, argument types) to compile, in order: `boundaries` (in the child process
+    when there is one), `collision` and `entry` (the entry points, trace_batch first) here."""
     types = _argument_types()
     return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
-        ("bottom", (transport.reflect_at_bottom,)),
-        ("water", (transport.collide, transport.enter_from_air, transport.leave_or_reflect)),
+        ("boundaries", (transport.enter_from_air, transport.leave_or_reflect,
+                        transport.reflect_at_bottom)),
+        ("collision", (transport.collide,)),
         ("entry", (trace_batch, component_density, transmittance)))}
 
 
@@ -104,11 +114,11 @@ def _in_cache() -> bool:
 
 
 def _start_child() -> subprocess.Popen | None:
-    """The child process that compiles the bottom part into the shared cache, if this machine
-    has a core to spare for it."""
+    """The child process that compiles the boundaries' part into the shared cache, if this
+    machine has a core to spare for it."""
     if (os.cpu_count() or 1) < 2:
         return None
-    code = "from oceanmc.run.compiling import compile_part; compile_part('bottom')"
+    code = "from oceanmc.run.compiling import compile_part; compile_part('boundaries')"
     try:
         return subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -132,7 +142,7 @@ def ready(should_stop: Callable[[], bool] | None = None):
                 if not _in_cache():
                     child = _start_child()
                     if child is not None:
-                        compile_part("water")   # while the child compiles the bottom part
+                        compile_part("collision")   # while the child compiles the boundaries
                         child.wait(timeout=CHILD_TIMEOUT_S)
                 compile_part("entry")
             except BaseException as exc:  # handed to the main thread
