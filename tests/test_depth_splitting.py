@@ -12,6 +12,7 @@ import copy
 
 import numpy as np
 import pytest
+import yaml
 
 import oceanmc
 from oceanmc import optics
@@ -45,7 +46,9 @@ def deep(mode, seed, **changes):
     config = copy.deepcopy(DEEP)
     config["seed"] = seed
     config.update(changes)
-    config["estimator"] = dict(config.get("estimator", {}), depth_splitting=mode)
+    # the windows alone: without the upward bias that auto adds to them (test_auto_upward_bias)
+    config["estimator"] = {"upward_fraction": None, **config.get("estimator", {}),
+                           "depth_splitting": mode}
     return config
 
 
@@ -168,6 +171,32 @@ def test_auto_rule():
     raman["estimator"]["depth_splitting"] = "on"
     with pytest.raises(ConfigError, match="depth_splitting = 'on' with water.inelastic"):
         oceanmc.load_config(raman)
+
+
+def test_auto_upward_bias_goes_with_the_windows_in_one_wavelength_scenes():
+    """estimator.upward_fraction auto in a one-wavelength implicit walk: 0.1 where the depth
+    windows are on, off where they are not (scene/weight_window.resolve_upward), and the stored
+    scene says which; a spectral walk has 0.1 either way, an explicit value is kept."""
+    def stored(mode, **estimator):
+        config = deep(mode, seed=1, photons=64, batches=2)
+        config["estimator"] = dict(depth_splitting=mode, **estimator)
+        result = oceanmc.simulate(config, threads=1)
+        return result.attrs["depth_splitting"].split(" ")[0], \
+            yaml.safe_load(result.config_yaml)["estimator"]["upward_fraction"]
+    assert stored("auto") == ("on", 0.1)
+    assert stored("off") == ("off", None)
+    assert stored("auto", upward_fraction=None) == ("on", None)
+    assert stored("off", upward_fraction=0.2) == ("off", 0.2)
+    shallow = oceanmc.load_config(deep("auto", seed=1, tallies={"depths_m": [0.0, 2.0]}))
+    assert shallow.estimator.upward_fraction is None   # deep() sets it null: check auto below
+    shallow = oceanmc.load_config(dict(deep("auto", seed=1, tallies={"depths_m": [0.0, 2.0]}),
+                                       estimator={"depth_splitting": "auto"}))
+    assert shallow.estimator.upward_fraction == "auto"   # left to the build
+    oceanmc.simulate(shallow, threads=1)
+    assert shallow.estimator.upward_fraction is None
+    spectral = oceanmc.load_config(dict(deep("off", seed=1, wavelengths_nm=[490.0, 530.0]),
+                                        estimator={"depth_splitting": "off"}))
+    assert spectral.estimator.upward_fraction == 0.1
 
 
 @pytest.mark.parametrize("value, expected", [("off", "off"), (False, "off"), ("on", "on"),

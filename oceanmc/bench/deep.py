@@ -5,8 +5,9 @@ The scene: 180 layers of 0.5 m of Case-1 water (the case1 component) with a deep
 maximum (a Gaussian of 4 mg/m3 at 40 m, 8 m wide, over 1 mg/m3), over infinitely deep water at
 the background, at 490 nm, sun at 30 deg with a 20% sky, flat sea; Ed, Eou and Lu tallied every
 5 m from 0 to 110 m, where Ed has fallen by e^-11. Run with windows (auto: on here) and without
-(off), both at the scene's defaults and with scattering biased toward straight up (fraction
-0.1, auto's choice in spectral scenes): per depth and quantity the time to a 1% relative
+(off), both at the scene's defaults (estimator.upward_fraction auto: scattering biased toward
+straight up by 0.1 where the windows are on, none without them; scene/weight_window.py) and
+without the bias: per depth and quantity the time to a 1% relative
 standard error, t (rel / 0.01)^2 with rel^2 the mean over interleaved repeats and t their
 median time on 2 threads, compilation excluded.
 
@@ -39,7 +40,8 @@ DEPTHS = [float(z) for z in range(0, 111, 5)]
 QUANTITIES = ("Ed", "Eou", "Lu")
 TARGET_REL, TARGET_S, TARGET_DEPTHS = 0.01, 60.0, 10.0
 BATCHES = 64
-VARIANTS = (("defaults", {}), ("upward bias 0.1", {"upward_fraction": 0.1}))
+VARIANTS = (("defaults (upward bias auto: 0.1 with the windows, none without them)", {}),
+            ("no upward bias", {"upward_fraction": None}))
 MODES = ("off", "auto")
 # the deepest tally of the auto-rule rows (m; six levels evenly from 0)
 AUTO_DEEPEST_M = (10.0, 20.0, 30.0, 40.0, 55.0)

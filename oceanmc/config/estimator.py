@@ -29,7 +29,9 @@ class Estimator(_Strict):
     uniformly in the cone of half-angle upward_cone_deg around straight up (in a layer of
     single-scattering albedo w0 the fraction is min(upward_fraction, 1 - w0)); for Lu,
     Lw_nadir and Rrs_nadir. auto (the default): AUTO_UPWARD_FRACTION in a spectral scene of
-    the implicit walk, off (null) otherwise; the scene resolves it (config/scene.py).
+    the implicit walk and in a one-wavelength one whose depth windows are on, off (null)
+    otherwise; resolved by config/scene.py, in one-wavelength scenes by the build
+    (scene/weight_window.resolve_upward).
     depth_splitting: depth importance weight windows (scene/weight_window.py): packets are
     split as they go deeper and play roulette as they come up, so that light is followed as
     well at the deepest tally depth as near the surface. auto (the default): on in an implicit

@@ -122,9 +122,13 @@ class SceneConfig(_Strict):
                              f"{self.bottom.model!r}: a mirror has no density for a local "
                              "estimate; use the quad radiances")
         if self.estimator.upward_fraction == "auto":
-            # resolved here, so that the stored config says what ran
-            self.estimator.upward_fraction = AUTO_UPWARD_FRACTION if (
-                self.estimator.mode == "implicit" and len(self.wavelengths) > 1) else None
+            # resolved here, so that the stored config says what ran; in a one-wavelength
+            # implicit walk by the scene's build, which decides the depth windows it goes with
+            # (scene/weight_window.py: resolve_upward)
+            if self.estimator.mode == "analog":
+                self.estimator.upward_fraction = None
+            elif len(self.wavelengths) > 1:
+                self.estimator.upward_fraction = AUTO_UPWARD_FRACTION
         if self.estimator.mode == "analog" and self.estimator.upward_fraction is not None:
             raise ValueError(f"estimator.upward_fraction = {self.estimator.upward_fraction} "
                              "with estimator.mode = 'analog': the biased scattering changes "

@@ -259,6 +259,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
 
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
     windows = weight_window.choose(config, layers)
+    weight_window.resolve_upward(config, windows)
     added = weight_window.added_planes(windows, layers, plane_z)
     if added.size:
         plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers,
