@@ -170,13 +170,16 @@ def report_lines(data: dict, commit: str) -> list[str]:
     raman = default["rows"]["Raman Rrs(550)"]
     own = elastic["rows"]["Rrs(550)"]["time_to_target_s"]
     share = raman["value"] / default["rows"]["Rrs(550)"]["value"]
+    same_run = default["rows"]["elastic Rrs(550)"]["time_to_target_s"]
     separate = (raman["time_to_target_s"] + own) / raman["time_to_target_s"]
     lines += [
         "", f"Cost of inelastic light at the defaults: {cost:.1f}x the elastic run's time for "
         "the same photons.",
         f"Raman part of Rrs(550) ({100 * share:.1f}% of the whole) to 1%: "
         f"{raman['time_to_target_s']:,.1f} s against {own:,.1f} s for the elastic run's Rrs(550)"
-        f": {raman['time_to_target_s'] / own:.1f}x (target: at most 2x).",
+        f": {raman['time_to_target_s'] / own:.1f}x (target: at most 2x); against the elastic "
+        f"part of Rrs(550) in the same run ({same_run:,.1f} s), whose photons it shares: "
+        f"{raman['time_to_target_s'] / same_run:.2f}x.",
         f"One history against the elastic run plus a separate inelastic run: the separate "
         f"way pays the elastic run's time on top, so the one history's figure of merit for "
         f"the inelastic parts is {separate:.2f}x the separate way's; its elastic part "
