@@ -237,3 +237,17 @@ def test_windows_in_turbid_weakly_absorbing_water_do_not_flood_the_walk():
     assert windows["depth_splitting"].startswith("on")
     assert windows["scattering_events"] < 3 * plain["scattering_events"], \
         (windows["scattering_events"], plain["scattering_events"])
+
+
+def test_the_same_seed_gives_the_same_bits_under_windows(monkeypatch):
+    """Two runs of one windowed scene in one process, with the batches cut into kernel calls at
+    other photons (and built anew): bit-identical (the phase-table pool once depended on
+    allocation addresses: tests/test_phase_table_pool.py)."""
+    from oceanmc.run import simulation
+    config = deep("on", seed=4, photons=4_000, batches=8)
+    first = oceanmc.simulate(config, threads=2)
+    monkeypatch.setattr(simulation, "FIRST_BUDGET", 300)
+    monkeypatch.setattr(simulation, "CALL_SECONDS", 0.002)
+    again = oceanmc.simulate(config, threads=1)
+    for name, q in first.quantities.items():
+        assert np.array_equal(q.batches, again.quantities[name].batches), name

@@ -3,6 +3,7 @@ segments, per-layer optical properties, the phase-function components of each la
 tables, and the per-layer upward-bias fractions."""
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -200,7 +201,13 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
     tab_start, tab_len, psi_start, q_parts, cdf_parts, guide_parts = [], [], [], [], [], []
     comp_tables: list = []      # (grid offset, q) of each tabulated component
     tab_offset = 0
-    table_at: dict[int, tuple[int, int]] = {}
+    # each distinct table once, known by its content. By id() of its angle array, as before,
+    # the pool depended on where tables happened to be allocated: Fournier-Forand's tables
+    # leave phase_tables' cache after 64, a re-made one is a new object, and a freed one's
+    # address may be taken by another. The deep chlorophyll column packed a table more or
+    # less from one build to the next in one process (and 79 against 78 cap tables), and with
+    # depth windows the same seed gave other results; the content is the same every time.
+    table_at: dict[bytes, tuple[int, int]] = {}
     # each distinct angle grid once (the Fournier-Forand tables of every wavelength share one),
     # so that one search locates an angle in all of a layer's tables (phase/dispatch.py)
     grid_at: dict[bytes, int] = {}
@@ -222,7 +229,8 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
                     psi_start.append(0)
                     comp_tables.append(None)
                     continue
-                key = id(table[0])
+                key = hashlib.sha1(np.ascontiguousarray(table[0]).tobytes()
+                                   + np.ascontiguousarray(table[1]).tobytes()).digest()
                 if key not in table_at:
                     table_at[key] = (tab_offset, len(table[0]))
                     q_parts.append(table[1])
