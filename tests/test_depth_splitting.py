@@ -175,25 +175,20 @@ def test_auto_rule():
 
 def test_auto_upward_bias_goes_with_the_windows_in_one_wavelength_scenes():
     """estimator.upward_fraction auto in a one-wavelength implicit walk: 0.1 where the depth
-    windows are on, off where they are not (scene/weight_window.resolve_upward), and the stored
-    scene says which; a spectral walk has 0.1 either way, an explicit value is kept."""
-    def stored(mode, **estimator):
+    windows are on, off where they are not (scene/weight_window.upward_fraction), as the
+    result's attribute says; the stored config keeps auto (so that rerunning it, or a sweep's
+    point, is the same scene); a spectral walk has 0.1 either way, an explicit value is kept."""
+    def ran(mode, **estimator):
         config = deep(mode, seed=1, photons=64, batches=2)
         config["estimator"] = dict(depth_splitting=mode, **estimator)
         result = oceanmc.simulate(config, threads=1)
-        return result.attrs["depth_splitting"].split(" ")[0], \
-            yaml.safe_load(result.config_yaml)["estimator"]["upward_fraction"]
-    assert stored("auto") == ("on", 0.1)
-    assert stored("off") == ("off", None)
-    assert stored("auto", upward_fraction=None) == ("on", None)
-    assert stored("off", upward_fraction=0.2) == ("off", 0.2)
-    shallow = oceanmc.load_config(deep("auto", seed=1, tallies={"depths_m": [0.0, 2.0]}))
-    assert shallow.estimator.upward_fraction is None   # deep() sets it null: check auto below
-    shallow = oceanmc.load_config(dict(deep("auto", seed=1, tallies={"depths_m": [0.0, 2.0]}),
-                                       estimator={"depth_splitting": "auto"}))
-    assert shallow.estimator.upward_fraction == "auto"   # left to the build
-    oceanmc.simulate(shallow, threads=1)
-    assert shallow.estimator.upward_fraction is None
+        stored = yaml.safe_load(result.config_yaml)["estimator"]["upward_fraction"]
+        return result.attrs["depth_splitting"].split(" ")[0], result.attrs["upward_fraction"], \
+            stored
+    assert ran("auto") == ("on", 0.1, "auto")
+    assert ran("off") == ("off", 0.0, "auto")
+    assert ran("auto", upward_fraction=None) == ("on", 0.0, None)
+    assert ran("off", upward_fraction=0.2) == ("off", 0.2, 0.2)
     spectral = oceanmc.load_config(dict(deep("off", seed=1, wavelengths_nm=[490.0, 530.0]),
                                         estimator={"depth_splitting": "off"}))
     assert spectral.estimator.upward_fraction == 0.1

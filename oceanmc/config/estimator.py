@@ -31,7 +31,7 @@ class Estimator(_Strict):
     Lw_nadir and Rrs_nadir. auto (the default): AUTO_UPWARD_FRACTION in a spectral scene of
     the implicit walk and in a one-wavelength one whose depth windows are on, off (null)
     otherwise; resolved by config/scene.py, in one-wavelength scenes by the build
-    (scene/weight_window.resolve_upward).
+    (scene/weight_window.upward_fraction; the result's attribute upward_fraction says it).
     depth_splitting: depth importance weight windows (scene/weight_window.py): packets are
     split as they go deeper and play roulette as they come up, so that light is followed as
     well at the deepest tally depth as near the surface. auto (the default): on in an implicit

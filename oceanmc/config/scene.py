@@ -123,8 +123,8 @@ class SceneConfig(_Strict):
                              "estimate; use the quad radiances")
         if self.estimator.upward_fraction == "auto":
             # resolved here, so that the stored config says what ran; in a one-wavelength
-            # implicit walk by the scene's build, which decides the depth windows it goes with
-            # (scene/weight_window.py: resolve_upward)
+            # implicit walk left to the scene's build, which decides the depth windows it goes
+            # with (scene/weight_window.upward_fraction; the result's attribute says the value)
             if self.estimator.mode == "analog":
                 self.estimator.upward_fraction = None
             elif len(self.wavelengths) > 1:

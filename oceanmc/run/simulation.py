@@ -284,6 +284,9 @@ def run_attrs(run: PreparedRun, batches: Batches, done: int, threads: int, wall:
         "illumination_diffuse_fraction": np.asarray(facts.diffuse, dtype=np.float64),
         # estimator.depth_splitting as decided for the scene, and why (scene/weight_window.py)
         "depth_splitting": run.scene.depth_splitting,
+        # estimator.upward_fraction as it ran, 0 for none (auto is left in the stored config
+        # of a one-wavelength scene: scene/weight_window.upward_fraction)
+        "upward_fraction": run.scene.upward_fraction,
     }
     if facts.inelastic:
         # the outputs' parts (derivation.add_parts), and the wavelengths traced for the

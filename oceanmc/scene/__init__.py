@@ -37,6 +37,8 @@ class Scene:
     bottom_reflectance: np.ndarray | None = None
     # estimator.depth_splitting as decided for the scene, and why (weight_window.choose)
     depth_splitting: str = "off"
+    # the upward bias it runs with, 0 for none (weight_window.upward_fraction)
+    upward_fraction: float = 0.0
 
     def kernel_args(self) -> tuple:
         return (self.medium, self.surface, self.bottom, self.sky, self.grid, self.estimates,
@@ -60,7 +62,7 @@ def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:
     """The ESTIMATOR records, one per segment of the column: under depth windows each holds its
     segment's window weight W and the roulette threshold at collisions there, max(roulette_weight,
     weight_window.ROULETTE_WEIGHT) x W (scene/weight_window.py)."""
-    upward = medium.upward_fractions(est, column.albedo)
+    upward = medium.upward_fractions(column.upward, column.albedo)
     rows = np.repeat(record(ESTIMATOR, analog=int(est.mode == "analog"),
                             roulette_weight=float(est.roulette_weight),
                             roulette_survival=float(est.roulette_survival),
@@ -104,7 +106,8 @@ def build(config: cfg.SceneConfig,
          (surf, surface.pool(config.surface, surf), no_ints)])
     return Scene(med, surf, bot, sk, gr, est, pack_estimator(config.estimator, column),
                  floats, ints, angles, local_rows, column.layers,
-                 optics.bottom_spectrum(config.bottom, config.wavelengths), column.windows.why)
+                 optics.bottom_spectrum(config.bottom, config.wavelengths), column.windows.why,
+                 float(column.upward or 0.0))
 
 
 __all__ = ["Scene", "Grid", "build", "make_grid"]

@@ -30,6 +30,7 @@ class Column:
     #                            into several layers of one configured layer)
     windows: weight_window.DepthWindows   # depth splitting: whether, and why
     window: np.ndarray         # the window weight of each segment between planes (1: none)
+    upward: float | None       # the upward bias the scene runs with (None: off)
 
 
 def _mixture(phase: cfg.Mixture) -> list:
@@ -103,10 +104,11 @@ B_SPREAD_LIMIT = 1e-12
 B_FLOOR = 1e-100
 
 
-def upward_fractions(estimator: cfg.Estimator, albedo: np.ndarray) -> np.ndarray:
-    """Scattering biased toward straight up (kernel/upward.py): a layer's fraction is at most
-    1 - w0, so that no scattering event makes a packet heavier; 0 in a layer leaves it out."""
-    fraction = np.minimum(float(estimator.upward_fraction or 0.0), 1.0 - albedo)
+def upward_fractions(upward: float | None, albedo: np.ndarray) -> np.ndarray:
+    """Scattering biased toward straight up (kernel/upward.py; upward: the scene's fraction,
+    weight_window.upward_fraction): a layer's fraction is at most 1 - w0, so that no
+    scattering event makes a packet heavier; 0 in a layer leaves it out."""
+    fraction = np.minimum(float(upward or 0.0), 1.0 - albedo)
     fraction[albedo <= 0.0] = 0.0
     return fraction
 
@@ -267,7 +269,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
 
     plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers)
     windows = weight_window.choose(config, layers)
-    weight_window.resolve_upward(config, windows)
+    upward = weight_window.upward_fraction(config, windows)
     added = weight_window.added_planes(windows, layers, plane_z)
     if added.size:
         plane_z, plane_tally, segment_layer, surface_level, depths = planes(config, layers,
@@ -278,7 +280,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
     plane_tau = np.array([optical_depths(plane_z, segment_layer, layer_c[:, j])
                           for j in range(n_wl)])                             # (n_wl, n_planes)
     level_tau = plane_tau[:, np.searchsorted(plane_z, depths)]              # (n_wl, n_depths)
-    fraction = upward_fractions(config.estimator, albedo)
+    fraction = upward_fractions(upward, albedo)
     cone = math.radians(config.estimator.upward_cone_deg)
     up_cos = math.cos(cone)
     up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
@@ -320,5 +322,5 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         channel_band=i.add([optics.inelastic.band(ch.transfer) for ch in inelastic]),
         channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers), windows,
-                    weight_window.segment_windows(windows, layers, plane_z))
+                    weight_window.segment_windows(windows, layers, plane_z), upward)
     return rec, f.array(), i.array(), column

@@ -121,16 +121,19 @@ def choose(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> DepthWind
                             f"{AUTO_ATTENUATION_DEPTHS:g})", deepest)
 
 
-def resolve_upward(config: cfg.SceneConfig, windows: DepthWindows) -> None:
-    """estimator.upward_fraction auto in a one-wavelength implicit walk (config/scene.py leaves
-    it to the build): AUTO_UPWARD_FRACTION where the depth windows are on, off elsewhere; written
-    into the config, so that the stored scene says what ran. The windows split packets on
-    their way down; the bias sends some of them back up toward the nadir-viewing cap, whose
-    local estimate otherwise keeps a heavy tail at every depth (benchmarks/deep.md, the
-    bench's stratified column: Lu to 1% in 285-490 s with the windows alone, 13-51 s with
-    both; Ed and Eou within 60 s either way)."""
-    if config.estimator.upward_fraction == "auto":
-        config.estimator.upward_fraction = AUTO_UPWARD_FRACTION if windows.on else None
+def upward_fraction(config: cfg.SceneConfig, windows: DepthWindows) -> float | None:
+    """The upward bias the scene runs with: estimator.upward_fraction, whose auto config/scene.py
+    leaves to the build in a one-wavelength implicit walk: AUTO_UPWARD_FRACTION where the depth
+    windows are on, off elsewhere (the result's attribute upward_fraction says which; the
+    stored config keeps auto, so that a rerun or a sweep's point is the same scene). The windows
+    split packets on their way down; the bias sends some of them back up toward the
+    nadir-viewing cap, whose local estimate otherwise keeps a heavy tail at every depth
+    (benchmarks/deep.md, the bench's stratified column: Lu to 1% in 250 s at 45 m with the
+    windows alone; every Ed, Eou and Lu within 27 s with both)."""
+    value = config.estimator.upward_fraction
+    if value == "auto":
+        return AUTO_UPWARD_FRACTION if windows.on else None
+    return value
 
 
 def added_planes(windows: DepthWindows, layers: list[optics.LayerIOPs],
