@@ -24,8 +24,8 @@ b (1 - g), which it never exceeds (1 - g = integral (1 - cos) p >= the backward 
 so that K errs low. Gordon's K alone grows with b_b without bound while the light of a turbid,
 weakly absorbing layer falls far slower: b = 1000 1/m of particles over 1 m (K 25 1/m by
 Gordon, 2.3 by diffusion) split every packet into e^15 copies (the fuzz test's run of 200
-photons had not ended after 20 minutes). A window that falls too slowly only splits less. Below the deepest tally depth nothing is tallied and W stays at its value
-there. The window is the same for every wavelength of a spectral walk: that of the least
+photons had not ended after 20 minutes). A window that falls too slowly only splits less.
+Below the deepest tally depth nothing is tallied and W stays at its value there. The window is the same for every wavelength of a spectral walk: that of the least
 attenuated one (the largest W), the light that reaches deepest; each packet is weighed by its
 heaviest wavelength (kernel/weight_window.py).
 
