@@ -25,9 +25,10 @@ so that K errs low. Gordon's K alone grows with b_b without bound while the ligh
 weakly absorbing layer falls far slower: b = 1000 1/m of particles over 1 m (K 25 1/m by
 Gordon, 2.3 by diffusion) split every packet into e^15 copies (the fuzz test's run of 200
 photons had not ended after 20 minutes). A window that falls too slowly only splits less.
-Below the deepest tally depth nothing is tallied and W stays at its value there. The window is the same for every wavelength of a spectral walk: that of the least
-attenuated one (the largest W), the light that reaches deepest; each packet is weighed by its
-heaviest wavelength (kernel/weight_window.py).
+Below the deepest tally depth nothing is tallied and W stays at its value there. The window is
+the same for every wavelength of a spectral walk: that of the least attenuated one (the
+largest W), the light that reaches deepest; each packet is weighed by its heaviest wavelength
+(kernel/weight_window.py).
 
 Segments are the walk's own (between its planes: layer boundaries, tally depths, the surface
 and the bottom); where a segment above the deepest tally spans more than PLANE_STEP attenuation
