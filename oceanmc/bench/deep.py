@@ -31,7 +31,7 @@ from .. import optics
 from ..config import load_config
 from ..run.simulation import simulate
 from ..scene import weight_window
-from .report import run_section
+from .report import error_over_spread, run_section
 
 WAVELENGTH_NM = 490.0
 LAYERS, LAYER_M = 180, 0.5
@@ -126,7 +126,7 @@ def _spread(photons: int, seeds: int, estimator: dict, say) -> dict:
         means = np.array([np.ravel(r[name]) for r in results])
         errors = np.array([np.ravel(r.stderr(name)) for r in results])
         z = (means - means.mean(axis=0)) / errors * math.sqrt(seeds / (seeds - 1))
-        ratio = np.sqrt((errors ** 2).mean(axis=0)) / means.std(axis=0, ddof=1)
+        ratio = error_over_spread(means, errors)
         out[name] = {"rms_z": float(np.sqrt((z ** 2).mean())), "max_abs_z": float(
             np.abs(z).max()), "ratio_median": float(np.median(ratio)),
             "ratio_min": float(ratio.min()), "ratio_max": float(ratio.max())}

@@ -24,7 +24,7 @@ import numpy as np
 from scipy import stats
 
 from ..run.simulation import simulate
-from .report import run_section
+from .report import error_over_spread, run_section
 
 BATCHES = 64
 TARGET_REL = 0.01
@@ -130,7 +130,7 @@ def spread(quick: bool, say) -> list[dict]:
                 rows.setdefault(label, []).append((value, rel * abs(value)))
         for label, pairs in rows.items():
             values, stderrs = np.array(pairs).T
-            ratio = float(np.sqrt(np.mean(stderrs ** 2)) / np.std(values, ddof=1))
+            ratio = float(error_over_spread(values, stderrs))
             dof = n_runs - 1
             # s^2 dof / sigma^2 ~ chi2(dof): the interval of sigma / s
             low, high = np.sqrt(stats.chi2.ppf([0.025, 0.975], dof) / dof)

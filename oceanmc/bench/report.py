@@ -255,6 +255,13 @@ def sampling_ratios(foms: list[dict]) -> list[dict]:
     return out
 
 
+def error_over_spread(means: np.ndarray, errors: np.ndarray) -> np.ndarray:
+    """Repeated runs (axis 0) of the same quantities: the root-mean-square of the runs' batch
+    standard errors over the standard deviation of their means, 1 when the error bars are
+    right (DESIGN 7.6)."""
+    return np.sqrt((errors ** 2).mean(axis=0)) / means.std(axis=0, ddof=1)
+
+
 def run_section(out_dir: Path, name: str, quick: bool, measure, lines) -> int:
     """A section of `oceanmc bench` on its own (--real-scenes, --inelastic): measure(quick,
     say) gives its data; DIR/name.json holds them with the kernel commit they measured,
