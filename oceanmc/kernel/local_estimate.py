@@ -56,6 +56,21 @@ def scratch(grid, work):
 
 
 @internal
+def cap_transmissions(grid, work):
+    """Views (n_wl each) of the transmissions from the point being scored up to the deepest
+    tally level above it (at the water cap's mu; 0 when no level is above) and up to 0+ (at
+    the air cap's mu), in the scratch row after the emissions' rows (records.work_size). A
+    collision's elastic light and each of its emissions are scored from the same point with
+    the same optical depths, so the first of their cap scores computes these exponentials and
+    the others read them (measured on the inelastic bench's scene, Raman and fluorescence: the
+    cap scores took half the run's time). The third view, one float, is 1 once they are
+    computed at this event (collide sets it to 0 at every collision)."""
+    n = grid.n_wl
+    at = (3 + grid.n_parts) * n
+    return work[at:at + n], work[at + n:at + 2 * n], work[at + 2 * n:at + 2 * n + 1]
+
+
+@internal
 def optical_depth(medium, floats, seg, layer, z, j):
     """tau at wavelength index j from the surface to depth z in segment seg (of the given
     layer)."""
@@ -142,20 +157,20 @@ def into_water_through_rough(surface, est, floats, k, rng):
 
 @internal
 def cap_from_collision(est, floats, grid, tally, share, above, tau_here, w_scattered, m0w, m1w,
-                       m0a, m1a, j):
+                       m0a, m1a, to_level, to_air, j):
     """The polar-cap average of the nadir-viewing radiance that a collision sends to the
     `above` levels above it and to 0+, at wavelength index j (see scene/estimates.py for the
-    expansion and its accuracy). The levels are sorted by depth: the transmission to the
-    deepest one above is one exp, and each level up multiplies it by the transmission between
-    the two levels (level_decay), so the cap costs two exps (water and air) whatever the
-    number of levels."""
+    expansion and its accuracy), given the transmissions to the deepest level above and to 0+
+    (cap_transmissions). The levels are sorted by depth: each level up multiplies the
+    transmission by the transmission between the two levels (level_decay), so the cap costs
+    two exps (water and air) whatever the number of levels."""
     n = grid.n_wl
     cap = grid.cap     # level l of wavelength j at cap + l n + j
     taus = grid.level_tau + j * grid.n_depths
     mu = est.mu_w
     if above > 0:
         decay = est.level_decay + j * grid.n_depths
-        transmitted = math.exp(-(tau_here - floats[taus + above - 1]) / mu)
+        transmitted = to_level
         scale = w_scattered / (mu * est.omega_w)
         for level in range(above - 1, -1, -1):
             dtau = tau_here - floats[taus + level]
@@ -163,8 +178,7 @@ def cap_from_collision(est, floats, grid, tally, share, above, tau_here, w_scatt
                 m0w + m1w * (dtau / mu - 1.0) / mu))
             transmitted *= floats[decay + level]
     mu = est.mu_a
-    e = math.exp(-tau_here / mu)
-    deposit(grid, tally, share, cap + grid.n_depths * n, j, w_scattered * e * (
+    deposit(grid, tally, share, cap + grid.n_depths * n, j, w_scattered * to_air * (
         m0a * est.h + m1a * (est.h * tau_here / (mu * mu) + est.dh)) / est.omega_a)
 
 
@@ -207,17 +221,18 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
                 add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k,
                               weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
-        cap_scores(est, grid, floats, ints, tally, share, weight, tau, z, uz,
+        cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz,
                    ints[est.table_of_layer + layer], 0, n, rng)
 
 
 @internal
-def cap_scores(est, grid, floats, ints, tally, share, weight, tau, z, uz, table, first, last,
-               rng):
+def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, table, first,
+               last, rng):
     """The polar-cap averages (to the levels above depth z and to 0+) of what a point of
     scattering sends up, for a packet travelling with direction cosine uz, from the cap tables
     `table` (a layer's phase function, or an inelastic emission's) at the wavelengths
-    first .. last - 1 (weights and optical depths `weight`, `tau`)."""
+    first .. last - 1 (weights `weight`; optical depths `tau` at every wavelength; the
+    transmissions of the event's first cap score, cap_transmissions)."""
     n = grid.n_wl
     # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
     # between the packet's direction and straight up, and the fraction to the next
@@ -247,10 +262,20 @@ def cap_scores(est, grid, floats, ints, tally, share, weight, tau, z, uz, table,
         if uniform(rng) * CAP_ROULETTE >= kept:
             return
         scale = CAP_ROULETTE / kept
+    to_level, to_air, computed = cap_transmissions(grid, work)
+    if computed[0] == 0.0:
+        computed[0] = 1.0
+        for j in range(n):
+            if above > 0:
+                to_level[j] = math.exp(-(tau[j] - floats[grid.level_tau + j * grid.n_depths
+                                                         + above - 1]) / est.mu_w)
+            else:
+                to_level[j] = 0.0
+            to_air[j] = math.exp(-tau[j] / est.mu_a)
     for j in range(first, last):
         m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
         cap_from_collision(est, floats, grid, tally, share, above, tau[j], weight[j] * scale,
-                           m0w, m1w, m0a, m1a, j)
+                           m0w, m1w, m0a, m1a, to_level[j], to_air[j], j)
 
 
 @internal
@@ -296,14 +321,14 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
     weight = work[2 * n:3 * n]
     tau = work[3 * n:4 * n]
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
-    for j in range(first, last):
+    for j in range(n):
         tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
     if est.directions_on:
         directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
                               tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
     if est.cap_on:
-        cap_scores(est, grid, floats, ints, tally, one_part, weight, tau, p.z, p.uz, table,
-                   first, last, rng)
+        cap_scores(est, grid, floats, ints, tally, one_part, work, weight, tau, p.z, p.uz,
+                   table, first, last, rng)
 
 
 @internal

@@ -191,8 +191,10 @@ def work_size(n_wl: int, n_parts: int = 1) -> int:
     function at every wavelength (kernel/local_estimate.py). An inelastic emission's weights
     per unit coefficient, what it takes and what it emits use the first three of these rows;
     what each inelastic process emits at a collision waits in one more row each until the
-    packet that carries it has turned (kernel/channels/inelastic.py)."""
-    return (4 + max(0, n_parts - 1)) * n_wl
+    packet that carries it has turned (kernel/channels/inelastic.py); last, the event's cap
+    transmissions, to the level above and to 0+, and whether they are computed yet
+    (local_estimate.cap_transmissions)."""
+    return (6 + max(0, n_parts - 1)) * n_wl + 1
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

@@ -71,7 +71,7 @@ from .phase import dispatch as phase
 from .phase import tabulated
 from .rng import uniform
 from .packet import belong_to, free_path_at, weights
-from .tally import deposit, spectral_at
+from .tally import deposit, deposit_all, spectral_at
 
 # a K_j past this, or positive below its inverse, settles the packet (its exponentials bring
 # the K back near 1), long before products of ratios could overflow or underflow; a K_j still
@@ -156,14 +156,18 @@ def settle(medium, floats, grid, tally, ps, p, layer):
     else:
         g_norm = norm
     w = p.w
-    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
     for j in range(n):
         k_j = k[j] * norm
         k[j] = k_j if k_j >= K_FLOOR else 0.0
         g[j] *= g_norm
-        now = w * g[j]
-        deposit(grid, tally, share, absorbed, j, last[j] - now)
-        last[j] = now
+    # what each wavelength lost since the last settle, F_j(last) - F_j(now), kept in `last`
+    # for the one booking of every wavelength (tally.deposit_all), then F_j(now) in its place
+    for j in range(n):
+        last[j] -= w * g[j]
+    deposit_all(grid, tally, share, spectral_at(grid, grid.budget + BUDGET_LAYERS + layer),
+                1.0, last)
+    for j in range(n):
+        last[j] = w * g[j]
 
 
 @internal
@@ -394,9 +398,8 @@ def lose(grid, tally, ps, layer):
     """The packet lost roulette, or the analog walk's absorption draw, in `layer`: what it
     carried at its last settle stays there (every collision since then was in that layer)."""
     _, _, last, share = weights(grid, ps)
-    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
-    for j in range(grid.n_wl):
-        deposit(grid, tally, share, absorbed, j, last[j])
+    deposit_all(grid, tally, share, spectral_at(grid, grid.budget + BUDGET_LAYERS + layer), 1.0,
+                last)
 
 
 @kernel

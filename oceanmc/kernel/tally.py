@@ -124,6 +124,26 @@ def deposit(grid, tally, share, at, j, value):
         tally[part * size + at + j] += value * share[part * n + j]
 
 
+@internal
+def deposit_all(grid, tally, share, at, w, values):
+    """deposit() of w times values[j] at every wavelength j, one part after the other: each
+    part's loop runs over contiguous wavelengths of the score and of the shares, which LLVM
+    vectorises (one deposit() per wavelength loops over the parts inside and does not;
+    measured on the inelastic bench's scene: splitting the scores by part took half the run's
+    time). Every element receives the same one addition as from deposit()."""
+    n = grid.n_wl
+    if share.shape[0] == 0:
+        for j in range(n):
+            tally[at + j] += w * values[j]
+        return
+    size = grid.part_size
+    for part in range(grid.n_parts):
+        row = tally[part * size + at:part * size + at + n]
+        part_share = share[part * n:(part + 1) * n]
+        for j in range(n):
+            row[j] += (w * values[j]) * part_share[j]
+
+
 @hot
 def score(grid, tally, ps, index, w):
     """Adds weight w to score `index` (its offset in one wavelength's layout), and in a
@@ -133,9 +153,7 @@ def score(grid, tally, ps, index, w):
         tally[index] += w
         return
     _, q, _, share = weights(grid, ps)
-    at = spectral_at(grid, index)
-    for j in range(grid.n_wl):
-        deposit(grid, tally, share, at, j, w * q[j])
+    deposit_all(grid, tally, share, spectral_at(grid, index), w, q)
 
 
 @kernel
@@ -159,12 +177,7 @@ def score_crossing(grid, floats, ints, tally, ps, level, w, ux, uy, uz, beam):
             tally[quad] += w_over_mu
         return
     _, q, _, share = weights(grid, ps)
-    plane = spectral_at(grid, plane)
-    scalar = spectral_at(grid, scalar)
-    for j in range(grid.n_wl):
-        deposit(grid, tally, share, plane, j, w * q[j])
-        deposit(grid, tally, share, scalar, j, w_over_mu * q[j])
+    deposit_all(grid, tally, share, spectral_at(grid, plane), w, q)
+    deposit_all(grid, tally, share, spectral_at(grid, scalar), w_over_mu, q)
     if quad >= 0:
-        quad = spectral_at(grid, quad)
-        for j in range(grid.n_wl):
-            deposit(grid, tally, share, quad, j, w_over_mu * q[j])
+        deposit_all(grid, tally, share, spectral_at(grid, quad), w_over_mu, q)

@@ -50,7 +50,7 @@ from ..geometry import turn
 from ..models import BUDGET_LAYERS, BUDGET_SHIFTED_IN, BUDGET_SHIFTED_OUT, BUDGET_TRUNCATED
 from ..phase import quadratic
 from ..rng import uniform
-from ..tally import deposit, spectral_at
+from ..tally import deposit_all, spectral_at
 
 
 @internal
@@ -70,15 +70,15 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     reach_at = medium.channel_reach + k * n
     part_size = grid.part_size
     share = packet.weights(grid, ps)[3]
-    absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
-    out = spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT)
     total = 0.0
     for j in range(n):
         x = density[j] * floats[sigma_at + j]
         taken[j] = x
-        deposit(grid, tally_row, share, absorbed, j, -x)
-        deposit(grid, tally_row, share, out, j, x)
         total += x * floats[reach_at + j]
+    deposit_all(grid, tally_row, share, spectral_at(grid, grid.budget + BUDGET_LAYERS + layer),
+                -1.0, taken)
+    deposit_all(grid, tally_row, share, spectral_at(grid, grid.budget + BUDGET_SHIFTED_OUT), 1.0,
+                taken)
     kept = work[(3 + channel) * n:(4 + channel) * n]   # what carry() adds to the packet
     for i in range(n):
         kept[i] = 0.0
