@@ -156,13 +156,12 @@ def settle(medium, floats, grid, tally, ps, p, layer):
     else:
         g_norm = norm
     w = p.w
+    # what each wavelength lost since the last settle, F_j(last) - F_j(now), kept in `last`
+    # for the one booking of every wavelength (tally.deposit_all), then F_j(now) in its place
     for j in range(n):
         k_j = k[j] * norm
         k[j] = k_j if k_j >= K_FLOOR else 0.0
         g[j] *= g_norm
-    # what each wavelength lost since the last settle, F_j(last) - F_j(now), kept in `last`
-    # for the one booking of every wavelength (tally.deposit_all), then F_j(now) in its place
-    for j in range(n):
         last[j] -= w * g[j]
     deposit_all(grid, tally, share, spectral_at(grid, grid.budget + BUDGET_LAYERS + layer),
                 1.0, last)
