@@ -63,8 +63,10 @@ def cap_transmissions(grid, work):
     collision's elastic light and each of its emissions are scored from the same point with
     the same optical depths, so the first of their cap scores computes these exponentials and
     the others read them (measured on the inelastic bench's scene, Raman and fluorescence: the
-    cap scores took half the run's time). The third view, one float, is 1 once they are
-    computed at this event (collide sets it to 0 at every collision)."""
+    cap scores took half the run's time; a scene without inelastic light computes them as it
+    scores: through the scratch row, its one-wavelength nadir cap lost 8% of its photons/s).
+    The third view, one float, is 1 once they are computed at this event (collide sets it to
+    0 at every collision of a scene with inelastic light)."""
     n = grid.n_wl
     at = (3 + grid.n_parts) * n
     return work[at:at + n], work[at + n:at + 2 * n], work[at + 2 * n:at + 2 * n + 1]
@@ -262,20 +264,34 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         if uniform(rng) * CAP_ROULETTE >= kept:
             return
         scale = CAP_ROULETTE / kept
+    # with inelastic light, the point's transmissions are computed once (cap_transmissions);
+    # a scene without scores each point's caps once and computes them as it goes
+    shared = grid.n_parts > 1
     to_level, to_air, computed = cap_transmissions(grid, work)
-    if computed[0] == 0.0:
+    if shared and computed[0] == 0.0:
         computed[0] = 1.0
         for j in range(n):
-            if above > 0:
-                to_level[j] = math.exp(-(tau[j] - floats[grid.level_tau + j * grid.n_depths
-                                                         + above - 1]) / est.mu_w)
-            else:
-                to_level[j] = 0.0
+            to_level[j] = transmission_to_level(est, floats, grid, tau[j], above, j)
             to_air[j] = math.exp(-tau[j] / est.mu_a)
     for j in range(first, last):
         m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
+        if shared:
+            level_t, air_t = to_level[j], to_air[j]
+        else:
+            level_t = transmission_to_level(est, floats, grid, tau[j], above, j)
+            air_t = math.exp(-tau[j] / est.mu_a)
         cap_from_collision(est, floats, grid, tally, share, above, tau[j], weight[j] * scale,
-                           m0w, m1w, m0a, m1a, to_level[j], to_air[j], j)
+                           m0w, m1w, m0a, m1a, level_t, air_t, j)
+
+
+@internal
+def transmission_to_level(est, floats, grid, tau_here, above, j):
+    """The transmission at the water cap's mu from optical depth tau_here up to the deepest of
+    the `above` tally levels above the point, at wavelength index j (0 when none is above)."""
+    if above == 0:
+        return 0.0
+    return math.exp(-(tau_here - floats[grid.level_tau + j * grid.n_depths + above - 1])
+                    / est.mu_w)
 
 
 @internal

@@ -224,8 +224,10 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
         # the collision's weight per unit coefficient at every wavelength, which the local
         # estimates (times b) and the inelastic channels (times theirs) read
         spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl])
-    # a new point: its cap transmissions are not computed yet (local_estimate.cap_transmissions)
-    local_estimate.cap_transmissions(grid, work)[2][0] = 0.0
+    if grid.n_parts > 1:
+        # a new point: its cap transmissions are not computed yet
+        # (local_estimate.cap_transmissions)
+        local_estimate.cap_transmissions(grid, work)[2][0] = 0.0
     if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
