@@ -265,7 +265,7 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
             return
         scale = CAP_ROULETTE / kept
     # with inelastic light, the point's transmissions are computed once (cap_transmissions);
-    # a scene without scores each point's caps once and computes them as it goes
+    # a scene without it scores each point's cap once and computes them as it goes
     shared = grid.n_parts > 1
     to_level, to_air, computed = cap_transmissions(grid, work)
     if shared and computed[0] == 0.0:
