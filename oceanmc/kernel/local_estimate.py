@@ -271,27 +271,27 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
     if shared and computed[0] == 0.0:
         computed[0] = 1.0
         for j in range(n):
-            to_level[j] = transmission_to_level(est, floats, grid, tau[j], above, j)
-            to_air[j] = math.exp(-tau[j] / est.mu_a)
+            to_level[j], to_air[j] = transmissions(est, floats, grid, tau[j], above, j)
     for j in range(first, last):
         m0w, m1w, m0a, m1a = cap_lookup(est, floats, table, i, f, n, j)
         if shared:
             level_t, air_t = to_level[j], to_air[j]
         else:
-            level_t = transmission_to_level(est, floats, grid, tau[j], above, j)
-            air_t = math.exp(-tau[j] / est.mu_a)
+            level_t, air_t = transmissions(est, floats, grid, tau[j], above, j)
         cap_from_collision(est, floats, grid, tally, share, above, tau[j], weight[j] * scale,
                            m0w, m1w, m0a, m1a, level_t, air_t, j)
 
 
 @internal
-def transmission_to_level(est, floats, grid, tau_here, above, j):
-    """The transmission at the water cap's mu from optical depth tau_here up to the deepest of
-    the `above` tally levels above the point, at wavelength index j (0 when none is above)."""
+def transmissions(est, floats, grid, tau_here, above, j):
+    """The transmissions from optical depth tau_here, at wavelength index j: at the water cap's
+    mu up to the deepest of the `above` tally levels above the point (0 when none is above),
+    and at the air cap's mu up to 0+."""
+    to_air = math.exp(-tau_here / est.mu_a)
     if above == 0:
-        return 0.0
+        return 0.0, to_air
     return math.exp(-(tau_here - floats[grid.level_tau + j * grid.n_depths + above - 1])
-                    / est.mu_w)
+                    / est.mu_w), to_air
 
 
 @internal
