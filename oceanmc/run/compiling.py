@@ -9,9 +9,9 @@ Ctrl-C (KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
 Numba compiles one function at a time, so on a machine with two or more cores the photon
 loop's events are compiled in two processes that meet in the disk cache: a child process
 compiles the events at the surface and the bottom (the rough sea's facet walk, the BRDFs, the
-local estimates from the bottom) while this one compiles the collision (the phase functions,
-the inelastic channels, the local estimates from a collision); trace_batch, compiled last,
-then loads the child's part from the cache. If the child fails or is slow, trace_batch
+local estimates from the bottom), the free flight and trace_batch's other callees while this
+one compiles the collision (the phase functions, the inelastic channels, the local estimates
+from a collision); trace_batch, compiled last, then loads the child's part from the cache. If the child fails or is slow, trace_batch
 compiles that part itself: the result is the same. trace_batch's own compilation is the
 longest single step and cannot be shared out: Numba links every callee's optimised LLVM IR into
 the entry point's module, then optimises it again (7.7 s, LLVM's pass timings) and generates
@@ -20,7 +20,12 @@ after the other in one process (2 cores, a CI run beside it): the collision 13.1
 events 4.6 s, the bottom 5.0 s, trace_batch 11.7 s. The collision alone here and the surface
 events beside the bottom in the child (before: collision and surface here, 16.3 s, against
 8.8 s there) took a cold `oceanmc run configs/default.yaml` from 27.6-29.7 s (kernel 23.9-25.2
-s) to 25.4-28.5 s (kernel 21.9-23.5 s), quiet machine, interleaved runs. (trace_batch at LLVM
+s) to 25.4-28.5 s (kernel 21.9-23.5 s), quiet machine, interleaved runs. Moving trace_batch's
+other callees (the free flight, the plane crossings, the photon's start: 2.6 s of Numba's
+front end that trace_batch compiled itself) into the child took a cold compilation (ready(),
+empty cache, interleaved, 2026-11-27) from 27.5-29.0 s to 25.3-26.4 s; giving the start and
+the sky's sampling back to this process instead, to balance the two, did not help (25.5-25.9
+s). (trace_batch at LLVM
 level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code then keeps dynamic
 globals, which Numba will not cache: every run would compile again.)
 """
@@ -38,7 +43,7 @@ import numba
 import numpy as np
 from numba.core.config import _OptLevel
 
-from ..kernel import records, transport
+from ..kernel import records, sources, spectral, transport
 from ..kernel.compile import CACHE_DIR
 from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
@@ -69,8 +74,9 @@ def _argument_types() -> dict[str, numba.types.Type]:
              "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
              "rng_emitted": numba.typeof(np.zeros(1, dtype=np.uint64)),
              "layer": numba.int64, "events": numba.int64, "wavelength": numba.int64,
-             "n_stacked": numba.int64,
-             "component": numba.int64,
+             "n_stacked": numba.int64, "target": numba.int64, "level": numba.int64,
+             "copies": numba.int64, "component": numba.int64, "tau": numba.float64,
+             "from_sky": numba.boolean,
              "n_photons": numba.int64, "start": numba.int64, "work_budget": numba.int64,
              "mu": numba.float64}
     for name, dtype in (("medium", records.MEDIUM), ("surface", records.SURFACE),
@@ -89,12 +95,17 @@ def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
 
 
 def parts() -> dict[str, list[tuple]]:
-    """(dispatcher, argument types) to compile, in order: `boundaries` (in the child process
-    when there is one), `collision` and `entry` (the entry points, trace_batch first) here."""
+    """(dispatcher, argument types) to compile, in order: `events` (in the child process when
+    there is one: the walk's events but the collision, and trace_batch's other callees),
+    `collision` and `entry` (the entry points, trace_batch first) here. A function compiled in
+    `events` with other argument types than trace_batch calls it with would only be compiled
+    again here, at no other cost (checked once: none is)."""
     types = _argument_types()
     return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
-        ("boundaries", (transport.enter_from_air, transport.leave_or_reflect,
-                        transport.reflect_at_bottom)),
+        ("events", (transport.enter_from_air, transport.leave_or_reflect,
+                    transport.reflect_at_bottom, transport.free_flight, transport.cross_plane,
+                    transport.after_reflection, transport.split_into, sources.sky_direction,
+                    spectral.start, component_density, transmittance)),
         ("collision", (transport.collide,)),
         ("entry", (trace_batch, component_density, transmittance)))}
 
@@ -116,11 +127,11 @@ def _in_cache() -> bool:
 
 
 def _start_child() -> subprocess.Popen | None:
-    """The child process that compiles the boundaries' part into the shared cache, if this
+    """The child process that compiles the part `events` into the shared cache, if this
     machine has a core to spare for it."""
     if (os.cpu_count() or 1) < 2:
         return None
-    code = "from oceanmc.run.compiling import compile_part; compile_part('boundaries')"
+    code = "from oceanmc.run.compiling import compile_part; compile_part('events')"
     try:
         return subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -144,7 +155,7 @@ def ready(should_stop: Callable[[], bool] | None = None):
                 if not _in_cache():
                     child = _start_child()
                     if child is not None:
-                        compile_part("collision")   # while the child compiles the boundaries
+                        compile_part("collision")   # while the child compiles the other events
                         child.wait(timeout=CHILD_TIMEOUT_S)
                 compile_part("entry")
             except BaseException as exc:  # handed to the main thread
