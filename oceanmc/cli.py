@@ -92,9 +92,29 @@ class StopRequest:
         signal.signal(signal.SIGTERM, self)
 
 
+def _ready_or_exit() -> None:
+    """Compiles the photon loop, or loads it from the cache; the first SIGINT or SIGTERM while
+    it compiles ends the process at once (the compilation goes on in its own thread inside
+    LLVM), with exit status 130 and nothing written. The signals' handlers are as before
+    afterwards."""
+    from .run.compiling import CompileInterrupted, ready
+    stop = StopRequest("stopping")
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    stop.install()
+    try:
+        ready(lambda: stop.requested)
+    except CompileInterrupted:
+        print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
+              "nothing was traced and no file was written", file=sys.stderr, flush=True)
+        sys.stdout.flush()
+        os._exit(130)
+    for signum, handler in zip((signal.SIGINT, signal.SIGTERM), before):
+        if handler is not None:   # None: not installed from Python, nothing to restore
+            signal.signal(signum, handler)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     from .config import ConfigError, load_config
-    from .run.compiling import CompileInterrupted
     from .run.merge import MergeError
     from .run.resume import CannotResume, RunFile, partial_run
     from .run.simulation import NonFiniteResult, prepare, simulate
@@ -106,15 +126,29 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise UsageError("two configs share a file name; give them different names or run them "
                          "separately with -o")
     overrides = {"photons": args.photons, "seed": args.seed}
+
+    def config_error(path: Path, exc: ConfigError) -> int:
+        print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
+              else f"oceanmc: config error: {exc}", file=sys.stderr)
+        return 2
+
+    loaded = []
+    for path in configs:
+        try:
+            loaded.append(load_config(path, overrides))
+        except ConfigError as exc:
+            return config_error(path, exc)
+    # the photon loop is compiled (or loaded) before any scene is packed: the packers call
+    # kernel functions, which the compiling child process then compiles off the critical path
+    # (run/compiling.py; packing first compiled them here, 2-3 s of a cold start)
+    _ready_or_exit()
     scenes = []
-    for path, out in zip(configs, outputs):
+    for path, out, config in zip(configs, outputs, loaded):
         try:
             # reads its data files: every scene is checked before any runs
-            run = prepare(load_config(path, overrides))
+            run = prepare(config)
         except ConfigError as exc:
-            print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
-                  else f"oceanmc: config error: {exc}", file=sys.stderr)
-            return 2
+            return config_error(path, exc)
         _check_writable(out, args.overwrite or (args.resume and out.exists()),
                         _file_size_estimate(run.config))
         previous = None
@@ -142,12 +176,6 @@ def cmd_run(args: argparse.Namespace) -> int:
             output.discard()
             print(f"oceanmc: error: {path}: {exc}", file=sys.stderr)
             return 3
-        except CompileInterrupted:
-            # the compilation goes on in its own thread inside LLVM; leave at once, no file
-            print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
-                  "nothing was traced and no file was written", file=sys.stderr, flush=True)
-            sys.stdout.flush()
-            os._exit(130)
         result.attrs["config_file"] = str(path)
         output.save(result)
         print(format_summary(result))

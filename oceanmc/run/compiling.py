@@ -25,7 +25,11 @@ other callees (the free flight, the plane crossings, the photon's start: 2.6 s o
 front end that trace_batch compiled itself) into the child took a cold compilation (ready(),
 empty cache, interleaved, 2026-11-27) from 27.5-29.0 s to 25.3-26.4 s; giving the start and
 the sky's sampling back to this process instead, to balance the two, did not help (25.5-25.9
-s). (trace_batch at LLVM
+s). `oceanmc run` compiles before it packs its scenes (cli.py), so that the packers' kernel
+function (component_density, 2-3 s cold) is the child's: a cold `oceanmc run
+configs/default.yaml --photons 20000` took 29.5-30.5 s before these two changes, 26.4-27.9 s
+after the first and 26.0-27.1 s after both (interleaved, 3 runs each; with component_density
+here after the collision, whose phase functions it shares, 26.9-27.7 s). (trace_batch at LLVM
 level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code then keeps dynamic
 globals, which Numba will not cache: every run would compile again.)
 """
