@@ -144,6 +144,19 @@ def _start_child() -> subprocess.Popen | None:
         return None
 
 
+# seconds that ready() spent compiling or loading the photon loop, not yet reported by a run
+# (startup_seconds): `oceanmc run` makes the loop ready before it packs its scenes, and its
+# first run still reports the time
+_unreported_startup = [0.0]
+
+
+def startup_seconds() -> float:
+    """The time ready() spent compiling or loading the photon loop since this was last asked
+    (0 once the loop is in this process)."""
+    seconds, _unreported_startup[0] = _unreported_startup[0], 0.0
+    return seconds
+
+
 def ready(should_stop: Callable[[], bool] | None = None):
     """trace_batch's compiled entry point (plain trace_batch under NUMBA_DISABLE_JIT=1)."""
     if not hasattr(trace_batch, "overloads"):
@@ -191,6 +204,7 @@ def ready(should_stop: Callable[[], bool] | None = None):
             raise
         if failure:
             raise failure[0]
+        _unreported_startup[0] += time.perf_counter() - t0
         if said:
             print(f"oceanmc: photon loop compiled in {time.perf_counter() - t0:.1f} s",
                   file=sys.stderr, flush=True)

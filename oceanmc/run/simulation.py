@@ -29,7 +29,7 @@ from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes,
 from ..kernel.records import PACKET, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
-from .compiling import ready
+from .compiling import ready, startup_seconds
 from .derivation import RunFacts, run_result
 from .merge import MergeError
 from .result import Result
@@ -319,10 +319,10 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
     # number of cores) is the default and the most
     n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
         else max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
-    t0 = time.perf_counter()
-    # compiles the kernel (or loads it from the cache) before the scene is packed, which uses it
+    # compiles the kernel (or loads it from the cache) before the scene is packed, which uses
+    # it; the time it took (here or before: cli.py) is the first run's start-up
     trace = ready(should_stop)
-    startup = time.perf_counter() - t0
+    startup = startup_seconds()
     run = config if isinstance(config, PreparedRun) else prepare(config)
     config, sc = run.config, run.scene
     if not 0 <= first_batch < config.batches:
