@@ -6,32 +6,35 @@ version and machine. ready() compiles them in a helper thread (LLVM releases the
 the main thread can say what is happening every few seconds on stderr and stop at once on
 Ctrl-C (KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
 
-Numba compiles one function at a time, so on a machine with two or more cores the photon
-loop's events are compiled in two processes that meet in the disk cache: a child process
-compiles the events at the surface and the bottom (the rough sea's facet walk, the BRDFs, the
-local estimates from the bottom), the free flight and trace_batch's other callees while this
-one compiles the collision (the phase functions, the inelastic channels, the local estimates
-from a collision); trace_batch, compiled last, then loads the child's part from the cache. If
-the child fails or is slow, trace_batch compiles that part itself: the result is the same.
+Numba compiles one function at a time, so on a machine with two or more cores the photon loop's
+events are compiled in two processes that meet in the disk cache: a child process compiles the
+events at the surface and the bottom (the rough sea's facet walk, the BRDFs, the local
+estimates from the bottom), the free flight and trace_batch's other callees while this one
+compiles the collision (the phase functions, the inelastic channels, the local estimates from a
+collision); trace_batch, compiled last, then loads the child's part from the cache. If the
+child fails or is slow, trace_batch compiles that part itself: the result is the same.
 trace_batch's own compilation is the longest single step and cannot be shared out: Numba links
-every callee's optimised LLVM IR into the entry point's module, then optimises it again (7.7 s, LLVM's pass timings) and generates
-machine code for all of it (4.8 s), after each callee did the same for its own. Measured one
-after the other in one process (2 cores, a CI run beside it): the collision 13.1 s, the surface
-events 4.6 s, the bottom 5.0 s, trace_batch 11.7 s. The collision alone here and the surface
-events beside the bottom in the child (before: collision and surface here, 16.3 s, against
-8.8 s there) took a cold `oceanmc run configs/default.yaml` from 27.6-29.7 s (kernel 23.9-25.2
-s) to 25.4-28.5 s (kernel 21.9-23.5 s), quiet machine, interleaved runs. Moving trace_batch's
-other callees (the free flight, the plane crossings, the photon's start: 2.6 s of Numba's
-front end that trace_batch compiled itself) into the child took a cold compilation (ready(),
-empty cache, interleaved, 2026-11-27) from 27.5-29.0 s to 25.3-26.4 s; giving the start and
-the sky's sampling back to this process instead, to balance the two, did not help (25.5-25.9
-s). `oceanmc run` compiles before it packs its scenes (cli.py), so that the packers' kernel
-function (component_density, 2-3 s cold) is the child's: a cold `oceanmc run
-configs/default.yaml --photons 20000` took 29.5-30.5 s before these two changes, 26.4-27.9 s
-after the first and 26.0-27.1 s after both (interleaved, 3 runs each; with component_density
-here after the collision, whose phase functions it shares, 26.9-27.7 s). (trace_batch at LLVM
-level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code then keeps dynamic
-globals, which Numba will not cache: every run would compile again.)
+every callee's optimised LLVM IR into the entry point's module, then optimises it again (7.7 s,
+LLVM's pass timings) and generates machine code for all of it (4.8 s), after each callee did
+the same for its own. Measured one after the other in one process (2 cores, a CI run beside
+it): the collision 13.1 s, the surface events 4.6 s, the bottom 5.0 s, trace_batch 11.7 s. The
+collision alone here and the surface events beside the bottom in the child (before: collision
+and surface here, 16.3 s, against 8.8 s there) took a cold `oceanmc run configs/default.yaml`
+from 27.6-29.7 s (kernel 23.9-25.2 s) to 25.4-28.5 s (kernel 21.9-23.5 s), quiet machine,
+interleaved runs. Moving trace_batch's other callees (the free flight, the plane crossings, the
+photon's start: 2.6 s of Numba's front end that trace_batch compiled itself) into the child
+took a cold compilation (ready(), empty cache, interleaved, 2026-11-27) from 27.5-29.0 s to
+25.3-26.4 s; giving the start and the sky's sampling back to this process instead, to balance
+the two, did not help (25.5-25.9 s). `oceanmc run` compiles before it packs its scenes
+(cli.py), so that the packers' kernel function (component_density, 2-3 s cold) is the child's:
+a cold `oceanmc run configs/default.yaml --photons 20000` took 29.5-30.5 s before these two
+changes, 26.4-27.9 s after the first and 26.0-27.1 s after both (interleaved, 3 runs each; with
+component_density here after the collision, whose phase functions it shares, 26.9-27.7 s).
+Now (ready(), empty cache, twice) the child exits at 12.7-13.1 s, the collision is compiled at
+13.3-13.8 s and trace_batch takes 9.2-9.5 s more: the two halves are balanced, and what is left
+is the collision's and trace_batch's own compilation.
+(trace_batch at LLVM level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code
+then keeps dynamic globals, which Numba will not cache: every run would compile again.)
 """
 from __future__ import annotations
 
