@@ -117,10 +117,7 @@ def component_moments(m, mf, mi, k: int, caps, geometry_key: bytes) -> np.ndarra
         table = cap_tables.cumulative(lambda angles: component_density(m, mf, mi, k, angles),
                                       component_table(m, mf, mi, k)[0])
         water, air = caps()
-        _COMPONENT_MOMENTS[key] = np.array(
-            [*cap_tables.cap_moments(table, water),
-             *(cap_tables.rough_cap_moments(table, air) if isinstance(air, cap_tables.RoughCap)
-               else cap_tables.cap_moments(table, air))])
+        _COMPONENT_MOMENTS[key] = np.array([*water.moments(table), *air.moments(table)])
         if len(_COMPONENT_MOMENTS) > 64:
             _COMPONENT_MOMENTS.pop(next(iter(_COMPONENT_MOMENTS)))
     return _COMPONENT_MOMENTS[key]
@@ -168,10 +165,7 @@ def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.nda
             lambda angles: 2.0 * math.pi * np.sin(angles) * np.array(
                 [quadratic.evaluate(params, math.cos(a)) for a in angles]), np.zeros(0))
         water, air = caps()
-        _COMPONENT_MOMENTS[key] = np.array(
-            [*cap_tables.cap_moments(table, water),
-             *(cap_tables.rough_cap_moments(table, air) if isinstance(air, cap_tables.RoughCap)
-               else cap_tables.cap_moments(table, air))])
+        _COMPONENT_MOMENTS[key] = np.array([*water.moments(table), *air.moments(table)])
     return _COMPONENT_MOMENTS[key]
 
 
