@@ -92,17 +92,18 @@ class StopRequest:
         signal.signal(signal.SIGTERM, self)
 
 
-def _ready_or_exit() -> None:
-    """Compiles the photon loop, or loads it from the cache; the first SIGINT or SIGTERM while
-    it compiles ends the process at once (the compilation goes on in its own thread inside
-    LLVM), with exit status 130 and nothing written. The signals' handlers are as before
+def _ready_or_exit(scene_files: list[Path]) -> None:
+    """Compiles the photon loop, or loads it from the cache (on a cold start the compiling
+    child packs scene_files meanwhile: run/compiling.py); the first SIGINT or SIGTERM while it
+    compiles ends the process at once (the compilation goes on in its own thread inside LLVM),
+    with exit status 130 and nothing written. The signals' handlers are as before
     afterwards."""
     from .run.compiling import CompileInterrupted, ready
     stop = StopRequest("stopping")
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     stop.install()
     try:
-        ready(lambda: stop.requested)
+        ready(lambda: stop.requested, scene_files)
     except CompileInterrupted:
         print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
               "nothing was traced and no file was written", file=sys.stderr, flush=True)
@@ -139,9 +140,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         except ConfigError as exc:
             return config_error(path, exc)
     # the photon loop is compiled (or loaded) before any scene is packed: the packers call
-    # kernel functions, which the compiling child process then compiles off the critical path
-    # (run/compiling.py; packing first compiled them here, 2-3 s of a cold start)
-    _ready_or_exit()
+    # kernel functions, which the compiling child process then compiles off the critical path,
+    # and it packs the scenes while trace_batch compiles (run/compiling.py; packing first
+    # compiled them here, 2-3 s of a cold start)
+    _ready_or_exit(configs)
     scenes = []
     for path, out, config in zip(configs, outputs, loaded):
         try:
