@@ -159,6 +159,27 @@ def test_start_up_time_is_the_first_runs_and_counts_loading_the_loop(tmp_path, s
         assert later.attrs["startup_time_s"] == 0.0
 
 
+def test_the_compiling_child_packs_the_scenes_it_is_given(tmp_path):
+    """On a cold start the compiling child (run/compiling.py child_main) says on stdout when its
+    part is compiled, then packs the scenes it was given, whose tables land in the disk caches
+    for the parent; a scene it cannot pack (here a missing file) is left to the parent, and the
+    child still ends well. (The compiled code is copied in, the tables are not.)"""
+    import shutil
+    from oceanmc.kernel.compile import CACHE_DIR
+    from oceanmc.run.compiling import EVENTS_COMPILED
+    cache = tmp_path / "cache"
+    shutil.copytree(CACHE_DIR, cache / CACHE_DIR.name)
+    code = "import sys; from oceanmc.run.compiling import child_main; child_main(sys.argv[1:])"
+    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "missing.yaml"),
+                           str(REPO / "configs" / "windy_case1.yaml")],
+                          env=dict(ENV, OCEANMC_CACHE_DIR=str(cache)), capture_output=True,
+                          text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == [EVENTS_COMPILED]
+    assert list((cache / "surface_tables").iterdir())
+    assert list((cache / "cap-moments").glob("*.npy"))
+
+
 def test_same_seed_gives_identical_files_apart_from_times(tmp_path, scene_file):
     for name, threads in (("a.h5", "1"), ("b.h5", "2")):
         done = oceanmc("run", scene_file, "-o", name, "-q", "--threads", threads, cwd=tmp_path)
