@@ -215,7 +215,10 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
                         _events_compiled(child)
                 compile_part("entry")
                 if child is not None:   # its packing of the scenes
-                    child.wait(timeout=CHILD_TIMEOUT_S)
+                    try:
+                        child.wait(timeout=CHILD_TIMEOUT_S)
+                    except subprocess.TimeoutExpired:   # the packing here does it instead
+                        child.kill()
             except BaseException as exc:  # handed to the main thread
                 failure.append(exc)
 
