@@ -192,3 +192,12 @@ def test_bad_phase_tables_name_the_file(tmp_path, small_scene, content, fragment
         oceanmc.simulate(small_scene)
     assert fragment in str(info.value)
     assert str(table) in str(info.value)
+
+
+def test_a_key_with_a_line_break_is_named_on_one_line():
+    """A key the fuzz test found ('\\n' under illumination): the message names it quoted, on
+    one line."""
+    with pytest.raises(ConfigError) as info:
+        load_config({"illumination": {"\n": None}})
+    message = str(info.value)
+    assert "\n" not in message and "illumination.'\\n'" in message, message

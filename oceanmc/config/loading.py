@@ -190,7 +190,10 @@ def _key_path(loc: tuple) -> str:
         elif part in _UNION_TAGS or str(part).startswith(("list[", "literal[")):
             continue  # pydantic's union-branch tags are not keys the user wrote
         else:
-            path += ("." if path else "") + str(part)
+            # a key with a line break or another unprintable character is shown quoted, so
+            # that the message stays one line
+            key = str(part) if str(part).isprintable() else repr(str(part))
+            path += ("." if path else "") + key
     return path or "(top level)"
 
 
