@@ -193,8 +193,9 @@ def work_size(n_wl: int, n_parts: int = 1) -> int:
     what each inelastic process emits at a collision waits in one more row each until the
     packet that carries it has turned (kernel/channels/inelastic.py); last, the event's cap
     transmissions, to the level above and to 0+, and whether they are computed yet
-    (local_estimate.cap_transmissions)."""
-    return (6 + max(0, n_parts - 1)) * n_wl + 1
+    (local_estimate.cap_transmissions), and a cap score's values and the transmissions it
+    carries up (local_estimate.cap_scratch)."""
+    return (8 + max(0, n_parts - 1)) * n_wl + 1
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

