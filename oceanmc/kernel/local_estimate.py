@@ -233,6 +233,31 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         if uniform(rng) * CAP_ROULETTE >= kept:
             return
         scale = CAP_ROULETTE / kept
+    # (see scene/estimates.py for the expansion and its accuracy; the tables' M0, M1 linear in
+    # alpha between nodes i and i + 1; no division per wavelength: each is a product with a
+    # reciprocal taken once, which changed the scores by rounding only)
+    g = 1.0 - f
+    node = (table * est.n_alpha + i) * n + first
+    per_mu = 1.0 / est.mu_w
+    water_factor = scale * per_mu / est.omega_w
+    air_factor = scale / est.omega_a
+    h_per_mu2 = est.h / (est.mu_a * est.mu_a)
+    if n == 1:
+        # one wavelength: scalars (through the scratch row's views, the bare walk's nadir cap
+        # lost 13% of its photons/s)
+        level_t, air_t = transmissions(est, floats, grid, tau[0], above, 0)
+        m0 = g * floats[est.cap_m0w + node] + f * floats[est.cap_m0w + node + 1]
+        m1 = g * floats[est.cap_m1w + node] + f * floats[est.cap_m1w + node + 1]
+        for level in range(above - 1, -1, -1):
+            deposit(grid, tally, share, grid.cap + level, 0, water_cap_score(
+                weight[0] * water_factor, level_t, m0, m1, tau[0] - floats[grid.level_tau + level],
+                per_mu))
+            level_t *= floats[est.level_decay + level]
+        m0 = g * floats[est.cap_m0a + node] + f * floats[est.cap_m0a + node + 1]
+        m1 = g * floats[est.cap_m1a + node] + f * floats[est.cap_m1a + node + 1]
+        deposit(grid, tally, share, grid.cap + grid.n_depths, 0, air_cap_score(
+            weight[0] * air_factor, air_t, m0, m1, tau[0], est.h, h_per_mu2, est.dh))
+        return
     # with inelastic light, the point's transmissions are computed once (cap_transmissions);
     # a scene without it computes them for the wavelengths it scores
     to_level, to_air, computed = cap_transmissions(grid, work)
@@ -243,13 +268,10 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         computed[0] = 1.0
         for j in range(n):
             to_level[j], to_air[j] = transmissions(est, floats, grid, tau[j], above, j)
-    # the tables' (M0, M1) at each wavelength, linear in alpha between nodes i and i + 1, and
-    # the scores (see scene/estimates.py for the expansion and its accuracy), one level at a
-    # time over the wavelengths first .. last - 1, through views that start at 0 (LLVM
-    # vectorises them; per wavelength, the scores took a third of the inelastic bench's run)
+    # the scores one level at a time over the wavelengths first .. last - 1, through views
+    # that start at 0, which LLVM vectorises (per wavelength, they took a third of the
+    # inelastic bench's run)
     count = last - first
-    g = 1.0 - f
-    node = (table * est.n_alpha + i) * n + first
     value_all, carried_all = cap_scratch(grid, work)
     value = value_all[:count]
     w = weight[first:last]
@@ -258,8 +280,6 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         # the levels are sorted by depth: each level up multiplies the transmission by the
         # transmission between the two levels (level_decay), so the cap costs two exps (water
         # and air) whatever the number of levels
-        mu = est.mu_w
-        per_omega = mu * est.omega_w
         m0_lo = floats[est.cap_m0w + node:est.cap_m0w + node + count]
         m0_hi = floats[est.cap_m0w + node + n:est.cap_m0w + node + n + count]
         m1_lo = floats[est.cap_m1w + node:est.cap_m1w + node + count]
@@ -268,29 +288,45 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         level_t = to_level[first:last]
         for j in range(count):
             carried[j] = level_t[j]
+        depths = grid.n_depths
         for level in range(above - 1, -1, -1):
+            # this level's optical depth and decay at each wavelength (stride n_depths)
+            at = first * depths + level
+            level_tau = floats[grid.level_tau + at:grid.level_tau + at + count * depths:depths]
+            decay = floats[est.level_decay + at:est.level_decay + at + count * depths:depths]
             for j in range(count):
-                at = (first + j) * grid.n_depths + level
-                dtau = tau_j[j] - floats[grid.level_tau + at]
-                m0w = g * m0_lo[j] + f * m0_hi[j]
-                m1w = g * m1_lo[j] + f * m1_hi[j]
-                value[j] = (w[j] * scale) / per_omega * carried[j] * (
-                    m0w + m1w * (dtau / mu - 1.0) / mu)
-                carried[j] *= floats[est.level_decay + at]
+                value[j] = water_cap_score(w[j] * water_factor, carried[j],
+                                           g * m0_lo[j] + f * m0_hi[j],
+                                           g * m1_lo[j] + f * m1_hi[j],
+                                           tau_j[j] - level_tau[j], per_mu)
+                carried[j] *= decay[j]
             deposit_range(grid, tally, share, grid.cap + level * n, first, 1.0, value)
-    mu = est.mu_a
-    h = est.h
     m0_lo = floats[est.cap_m0a + node:est.cap_m0a + node + count]
     m0_hi = floats[est.cap_m0a + node + n:est.cap_m0a + node + n + count]
     m1_lo = floats[est.cap_m1a + node:est.cap_m1a + node + count]
     m1_hi = floats[est.cap_m1a + node + n:est.cap_m1a + node + n + count]
     air_t = to_air[first:last]
     for j in range(count):
-        m0a = g * m0_lo[j] + f * m0_hi[j]
-        m1a = g * m1_lo[j] + f * m1_hi[j]
-        value[j] = (w[j] * scale) * air_t[j] * (
-            m0a * h + m1a * (h * tau_j[j] / (mu * mu) + est.dh)) / est.omega_a
+        value[j] = air_cap_score(w[j] * air_factor, air_t[j], g * m0_lo[j] + f * m0_hi[j],
+                                 g * m1_lo[j] + f * m1_hi[j], tau_j[j], est.h, h_per_mu2,
+                                 est.dh)
     deposit_range(grid, tally, share, grid.cap + grid.n_depths * n, first, 1.0, value)
+
+
+@internal
+def water_cap_score(weight, transmitted, m0, m1, dtau, per_mu):
+    """The water cap's average radiance at a level dtau above a point of scattering that sends
+    weight (over the cap's mu and solid angle) up, transmitted to the level at the cap's mu
+    (scene/estimates.py: M0 + M1 (dtau / mu - 1) / mu)."""
+    return weight * transmitted * (m0 + m1 * (dtau * per_mu - 1.0) * per_mu)
+
+
+@internal
+def air_cap_score(weight, transmitted, m0, m1, tau, h, h_per_mu2, dh):
+    """The air cap's average radiance at 0+ from a point of scattering at optical depth tau that
+    sends weight (over the air cap's solid angle) up, transmitted at the air cap's mu
+    (scene/estimates.py: M0 h + M1 (h tau / mu^2 + dh))."""
+    return weight * transmitted * (m0 * h + m1 * (tau * h_per_mu2 + dh))
 
 
 @internal
