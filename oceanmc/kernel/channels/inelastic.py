@@ -207,19 +207,36 @@ def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)
         factor = quadratic.evaluate(floats[medium.channel_beta + channel:], cos_psi) / density
         shifted_in = channel * grid.part_size + spectral_at(grid,
                                                             grid.budget + BUDGET_SHIFTED_IN)
+        shifted = tally_row[shifted_in:shifted_in + n]
         for i in range(n):
             kept[i] *= factor
             added[i] += kept[i]
-            tally_row[shifted_in + i] += kept[i]
+            shifted[i] += kept[i]
+    # each wavelength's light with the emissions, the part of it that the shares it had keep
+    # (1 where nothing was added) and its reciprocal, then the shares part by part over
+    # contiguous wavelengths, which LLVM vectorises (wavelength by wavelength with the parts
+    # inside, the shares took a fifth of the inelastic bench's run). The scratch rows of the
+    # hero's posterior and of the emission are free: the scattering has read the one, the
+    # channels' rows hold the other
+    keep = work[n:2 * n]
+    per_after = work[2 * n:3 * n]
     per_w = 1.0 / p.w
     for i in range(n):
-        if added[i] <= 0.0:
-            continue
-        after = last[i] + added[i]
-        keep = last[i] / after
-        for part in range(grid.n_parts):
-            share[part * n + i] *= keep
-        for channel in range(1, medium.n_channels):
-            share[channel * n + i] += work[(3 + channel) * n + i] / after
-        g[i] += added[i] * per_w
-        last[i] = after
+        if added[i] > 0.0:
+            after = last[i] + added[i]
+            keep[i] = last[i] / after
+            per_after[i] = 1.0 / after
+            g[i] += added[i] * per_w
+            last[i] = after
+        else:
+            keep[i] = 1.0
+            per_after[i] = 0.0
+    for part in range(grid.n_parts):
+        part_share = share[part * n:(part + 1) * n]
+        for i in range(n):
+            part_share[i] *= keep[i]
+    for channel in range(1, medium.n_channels):
+        kept = work[(3 + channel) * n:(4 + channel) * n]
+        part_share = share[channel * n:(channel + 1) * n]
+        for i in range(n):
+            part_share[i] += kept[i] * per_after[i]
