@@ -154,12 +154,23 @@ def into_water_through_rough(surface, est, floats, k, rng):
 
 
 @internal
+def collision_depths(medium, floats, grid, work, p, layer):
+    """The optical depth of packet p's collision point at every wavelength, into the scratch's
+    view (scratch) that the collision's local estimates and its emissions' read (once per
+    collision: computed for each emission, it took 4% of the inelastic bench's run)."""
+    tau = scratch(grid, work)[1]
+    for j in range(grid.n_wl):
+        tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
+
+
+@internal
 def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, layer,
                  w_scattered, rng):
     """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene;
     in a spectral walk its weight per unit coefficient at each wavelength in work[:n_wl],
-    spectral.collision_density) sends into the exact directions (at every level above it and
-    0+), and the polar-cap average of the nadir-viewing radiance, at every wavelength."""
+    spectral.collision_density; the point's optical depths in the scratch, collision_depths)
+    sends into the exact directions (at every level above it and 0+), and the polar-cap
+    average of the nadir-viewing radiance, at every wavelength."""
     n = grid.n_wl
     weight, tau, phase_j = scratch(grid, work)
     share = weights(grid, ps)[3]
@@ -168,8 +179,6 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
     else:
         spectral.collision_weights(medium, floats, grid, layer, work[:n], weight)
     z = p.z
-    for j in range(n):
-        tau[j] = optical_depth(medium, floats, p.seg, layer, z, j)
     ux, uy, uz = p.ux, p.uy, p.uz
     if est.directions_on:
         rough = surface.delta == 0
@@ -376,16 +385,14 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
 def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, table,
                 first, last, rng):
     """An inelastic emission at packet p's collision (its weights at each wavelength in
-    work[2 n:3 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
+    work[3 n:4 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
     beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
     directions (directions_from_point) and the polar-cap averages (cap_scores, as a
     collision's), scored in the emission's part of the tally row, where `tally` starts."""
     n = grid.n_wl
-    weight = work[2 * n:3 * n]
-    tau = work[3 * n:4 * n]
+    weight = work[3 * n:4 * n]
+    tau = scratch(grid, work)[1]   # the collision's (collision_depths)
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
-    for j in range(n):
-        tau[j] = optical_depth(medium, floats, p.seg, layer, p.z, j)
     if est.directions_on:
         directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
                               tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)

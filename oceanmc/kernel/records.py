@@ -189,9 +189,11 @@ def work_size(n_wl: int, n_parts: int = 1) -> int:
     """Floats of one event's scratch: a collision's volume scattering function at every
     wavelength (kernel/spectral.py), then a local estimate's weight, optical depth and phase
     function at every wavelength (kernel/local_estimate.py). An inelastic emission's weights
-    per unit coefficient, what it takes and what it emits use the first three of these rows;
-    what each inelastic process emits at a collision waits in one more row each until the
-    packet that carries it has turned (kernel/channels/inelastic.py); last, the event's cap
+    per unit coefficient, what it takes and what it emits use the first, second and fourth of
+    these rows (the third holds the collision point's optical depths, which its local estimates
+    read: local_estimate.collision_depths); what each inelastic process emits at a collision
+    waits in one more row each until the packet that carries it has turned
+    (kernel/channels/inelastic.py); last, the event's cap
     transmissions, to the level above and to 0+, and whether they are computed yet
     (local_estimate.cap_transmissions), and a cap score's values and the transmissions it
     carries up (local_estimate.cap_scratch)."""

@@ -228,6 +228,8 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
         # a new point: its cap transmissions are not computed yet
         # (local_estimate.cap_transmissions)
         local_estimate.cap_transmissions(grid, work)[2][0] = 0.0
+    if est.directions_on or est.cap_on:   # read by the local estimates and the emissions'
+        local_estimate.collision_depths(medium, floats, grid, work, p, layer)
     if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)

@@ -101,7 +101,7 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     # fluorescence into 685 +- 64 nm), so each excitation row adds to its band only, through
     # views that start at 0 (an offset index costs a wraparound test per element: measured
     # 1.6x slower, banded loops alone)
-    emission = work[2 * n:3 * n]
+    emission = work[3 * n:4 * n]   # (the third row holds the point's optical depths)
     transfer_at = medium.channel_transfer + k * n * n
     band_at = medium.channel_band + 2 * k * n
     for i in range(n):
@@ -219,7 +219,7 @@ def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)
     # hero's posterior and of the emission are free: the scattering has read the one, the
     # channels' rows hold the other
     keep = work[n:2 * n]
-    per_after = work[2 * n:3 * n]
+    per_after = work[3 * n:4 * n]
     per_w = 1.0 / p.w
     for i in range(n):
         if added[i] > 0.0:
