@@ -542,3 +542,23 @@ def test_bad_values_are_refused_with_one_clear_line(inelastic, needles):
     assert "\n" not in message.strip(), message
     for needle in needles:
         assert needle in message, (needle, message)
+
+
+# --- the Fraunhofer lines (validation case fraunhofer, Ge, Gordon & Voss 1993) -------------------
+
+
+def test_raman_light_fills_in_the_656_nm_line_with_depth_not_the_486_nm_one(tmp_path):
+    """A solar line halving the 1-nm band at 486 and 656 nm (and 518, 589), Chl 0.05, 20k
+    photons: at 0- the lines are whole in Ed (filling < 0.01); at 50 m the 656 nm line is gone
+    from Ed (filling > 0.9: the light there is Raman light) and the 486 nm line is not
+    (< 0.05). Measured (seed 7): at most 0.0022, 0.997, 0.012 (standard errors below 5e-3)."""
+    from oceanmc.validation.cases import fraunhofer
+    config = fraunhofer.water(fraunhofer.CLEAR, 20_000, fraunhofer.solar_table(tmp_path))
+    config.update(seed=7, batches=BATCHES)
+    f, rel = fraunhofer.filling(oceanmc.simulate(config, threads=2), "Ed")
+    lines = list(fraunhofer.LINES_NM)
+    surface, deep = fraunhofer.DEPTHS_M.index(0.0), fraunhofer.DEPTHS_M.index(50.0)
+    assert np.all(np.abs(f.value[:, surface]) < 0.01)
+    assert rel[lines.index(656.0), deep] < fraunhofer.WELL_MEASURED
+    assert f.value[lines.index(656.0), deep] > 0.9
+    assert f.value[lines.index(486.0), deep] < 0.05

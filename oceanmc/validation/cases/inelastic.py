@@ -125,8 +125,7 @@ def case_inelastic(ctx: Ctx) -> None:
         "excitation wavelength equals the quantum yield times the share of the absorption "
         "that is phytoplankton's, two estimators of the same light (collisions, and the "
         "budget's absorption by settles). The Fraunhofer lines' infilling with depth (Ge, "
-        "Gordon & Voss 1993) is not checked: the solar spectra oceanmc has (SPECTRL2, flat, "
-        "a user's table) have no Fraunhofer lines at their resolution.")
+        "Gordon & Voss 1993): validation case fraunhofer.")
 
 
 def compare_thin_layer(ctx: Ctx) -> None:
