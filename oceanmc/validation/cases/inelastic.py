@@ -2,17 +2,17 @@
 kernel/channels/inelastic.py) against an independent calculation that shares no code with the
 kernel (validation/raman_reference.py: single scattering by quadrature, and a slow walk that
 changes each photon's wavelength explicitly); the elastic part of a run against the same scene
-without inelastic light (same seed); energy and photon closure of every part; fluorescence
-against its quantum yield; the Raman share of Rrs(550) in clear water."""
+without inelastic light (same seed); energy and photon closure of every part; chlorophyll and
+CDOM fluorescence against their quantum yields; the Raman share of Rrs(550) in clear water."""
 from __future__ import annotations
 
 import numpy as np
 
 from .. import raman_reference
 from ... import config as cfg
-from ...config.inelastic import ChlorophyllFluorescence, Raman
+from ...config.inelastic import CdomFluorescence, ChlorophyllFluorescence, Raman
 from ...optics import column_iops
-from ...optics.inelastic import raman
+from ...optics.inelastic import cdom_fluorescence, raman
 from ..context import Ctx
 from .common import Case, _plt, scene
 
@@ -100,6 +100,7 @@ def case_inelastic(ctx: Ctx) -> None:
     elastic, whole, seed = compare_elastic_part(ctx)
     check_fluorescence(ctx)
     compare_packets(ctx, whole, elastic, seed)
+    check_fluorescence(ctx, "cdom_fluorescence")   # last: the earlier scenes keep their places
     check_closure(ctx, whole)
     plot(ctx, whole)
     ctx.note(
@@ -124,7 +125,8 @@ def case_inelastic(ctx: Ctx) -> None:
         "about a tenth). Fluorescence (Chl 1, fluorescence alone): what it takes at each "
         "excitation wavelength equals the quantum yield times the share of the absorption "
         "that is phytoplankton's, two estimators of the same light (collisions, and the "
-        "budget's absorption by settles). The Fraunhofer lines' infilling with depth (Ge, "
+        "budget's absorption by settles); CDOM fluorescence (Chl 1, its case1 CDOM, alone) "
+        "likewise against Hawes's quantum yield Phi(l') times CDOM's share. The Fraunhofer lines' infilling with depth (Ge, "
         "Gordon & Voss 1993): validation case fraunhofer.")
 
 
@@ -232,25 +234,34 @@ def compare_packets(ctx: Ctx, whole, elastic, seed) -> None:
                            whole, quantity, packets, quantity, lit, grid)
 
 
-def check_fluorescence(ctx: Ctx) -> None:
-    """What fluorescence takes at each excitation wavelength (collision estimates, the
-    budget's shifted_out) against quantum yield x a_ph / a x all the light absorbed there
-    (the budget's absorption, booked by settles), batch by batch."""
-    config = clear_water("Chl 1, fluorescence alone", ctx.pick(400_000, 100_000),
-                         {"chlorophyll_fluorescence": {}}, ctx.next_seed())
+def check_fluorescence(ctx: Ctx, process: str = "chlorophyll_fluorescence") -> None:
+    """What a fluorescence (chlorophyll's, or CDOM's) takes at each excitation wavelength
+    (collision estimates, the budget's shifted_out) against its quantum yield x the share of
+    the absorption that fluoresces (a_ph / a; a_CDOM / a) x all the light absorbed there (the
+    budget's absorption, booked by settles), batch by batch, in Chl 1 Case-1 water with that
+    process alone."""
+    label = "fluorescence" if process == "chlorophyll_fluorescence" else "CDOM fluorescence"
+    config = clear_water(f"Chl 1, {label} alone", ctx.pick(400_000, 100_000), {process: {}},
+                         ctx.next_seed())
     config["water"]["layers"][0]["components"][1]["chl_mg_m3"] = 1.0
     result = ctx.simulate(config)
     layer = column_iops(cfg.load_config(config))[0]
     grid = result.coords["wavelength"]
-    settings = ChlorophyllFluorescence()
+    if process == "chlorophyll_fluorescence":
+        settings = ChlorophyllFluorescence()
+        share = settings.quantum_yield * layer.a_phytoplankton / layer.a
+        formula = "yield x a_ph / a"
+    else:
+        settings = CdomFluorescence()
+        share = cdom_fluorescence.quantum_yield(settings, grid) * layer.a_cdom / layer.a
+        formula = "Phi(l') x a_CDOM / a (Hawes 1992)"
     low, high = settings.excitation_range_nm
-    inside = (grid >= low) & (grid <= high)
+    inside = (grid >= low) & (grid <= high) & (share > 0.0)
     q = result.quantities
     out = q["elastic/budget/shifted_out"].batches[:, inside]
     absorbed = q["elastic/budget/absorbed_layer_1"].batches[:, inside] + out
-    expected = settings.quantum_yield * (layer.a_phytoplankton / layer.a)[inside] * absorbed
-    compare_batches(ctx, "Chl 1: fluorescence's take = yield x a_ph / a x absorbed, per "
-                    "excitation wavelength (two estimators, batch by batch)", out, expected,
+    compare_batches(ctx, f"Chl 1: {label}'s take = {formula} x absorbed, per excitation "
+                    "wavelength (two estimators, batch by batch)", out, share[inside] * absorbed,
                     [f"{w:g} nm" for w in grid[inside]])
 
 
