@@ -30,9 +30,12 @@ the two, did not help (25.5-25.9 s). `oceanmc run` compiles before it packs its 
 a cold `oceanmc run configs/default.yaml --photons 20000` took 29.5-30.5 s before these two
 changes, 26.4-27.9 s after the first and 26.0-27.1 s after both (interleaved, 3 runs each; with
 component_density here after the collision, whose phase functions it shares, 26.9-27.7 s).
-Now (ready(), empty cache, twice) the child exits at 12.7-13.1 s, the collision is compiled at
-13.3-13.8 s and trace_batch takes 9.2-9.5 s more: the two halves are balanced, and what is left
-is the collision's and trace_batch's own compilation. While trace_batch compiles, the child
+Now (ready(), empty cache, twice; kernel bcac4d9) the child exits at 12.7-13.1 s, the
+collision is compiled at 13.3-13.8 s and trace_batch takes 9.2-9.5 s more: the two halves are
+balanced, and what is left is the collision's and trace_batch's own compilation. Kernel
+e4782e8's vectorised cap scores, emission bands and carried shares added 4-5 s (one process:
+32.3 s against 37.5 s, trace_batch +1.8 s, the cap scores +1.3 s, the collision +0.7 s; ready(),
+interleaved: 23.7-24.8 s against 27.5-29.1 s). While trace_batch compiles, the child
 packs the scenes `oceanmc run` was given (child_main): a cold `oceanmc run CONFIG --photons
 20000` (interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2 s for
 deep_chlorophyll_maximum.yaml, 27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml, with
