@@ -215,7 +215,7 @@ def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)
     # each wavelength's light with the emissions, the part of it that the shares it had keep
     # (1 where nothing was added) and its reciprocal, then the shares part by part over
     # contiguous wavelengths, which LLVM vectorises (wavelength by wavelength with the parts
-    # inside, the shares took a fifth of the inelastic bench's run). The scratch rows of the
+    # inside, they took about 8% of the inelastic bench's run by perf). The scratch rows of the
     # hero's posterior and of the emission are free: the scattering has read the one, the
     # channels' rows hold the other
     keep = work[n:2 * n]
