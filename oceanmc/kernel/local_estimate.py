@@ -32,6 +32,7 @@ import math
 from . import spectral
 from .brdf import dispatch as brdf
 from .compile import internal, kernel
+from .exp import exp
 from .geometry import from_angles
 from .packet import weights
 from .phase import dispatch as phase
@@ -271,12 +272,10 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
     # a scene without it computes them for the wavelengths it scores
     to_level, to_air, computed = cap_transmissions(grid, work)
     if grid.n_parts == 1:
-        for j in range(first, last):
-            to_level[j], to_air[j] = transmissions(est, floats, grid, tau[j], above, j)
+        spectral_transmissions(est, floats, grid, tau, above, first, last, to_level, to_air)
     elif computed[0] == 0.0:
         computed[0] = 1.0
-        for j in range(n):
-            to_level[j], to_air[j] = transmissions(est, floats, grid, tau[j], above, j)
+        spectral_transmissions(est, floats, grid, tau, above, 0, n, to_level, to_air)
     # the scores one level at a time over the wavelengths first .. last - 1, through views
     # that start at 0, which LLVM vectorises (per wavelength, they took a third of the
     # inelastic bench's run)
@@ -348,6 +347,26 @@ def transmissions(est, floats, grid, tau_here, above, j):
         return 0.0, to_air
     return math.exp(-(tau_here - floats[grid.level_tau + j * grid.n_depths + above - 1])
                     / est.mu_w), to_air
+
+
+@internal
+def spectral_transmissions(est, floats, grid, tau, above, first, last, to_level, to_air):
+    """transmissions() at the wavelengths first .. last - 1 (optical depths tau), into the views
+    to_level and to_air: loops over wavelengths with exp.py's exp, which LLVM vectorises (one
+    wavelength keeps the scalar transmissions() and libm's exp, whose latency is shorter)."""
+    count = last - first
+    tau_j = tau[first:last]
+    air_t = to_air[first:last]
+    for j in range(count):
+        air_t[j] = exp(-tau_j[j] / est.mu_a)
+    level_t = to_level[first:last]
+    if above == 0:
+        level_t[:] = 0.0
+        return
+    at = grid.level_tau + first * grid.n_depths + above - 1
+    nearest = floats[at:at + count * grid.n_depths:grid.n_depths]
+    for j in range(count):
+        level_t[j] = exp(-(tau_j[j] - nearest[j]) / est.mu_w)
 
 
 @internal

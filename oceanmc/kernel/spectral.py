@@ -66,6 +66,7 @@ function and the upward cone (scatter_weights).
 import math
 
 from .compile import internal, kernel
+from .exp import exp
 from .models import BUDGET_BOTTOM, BUDGET_LAYERS, BUDGET_LOST_BELOW, PHASE_TABULATED
 from .phase import dispatch as phase
 from .phase import tabulated
@@ -141,7 +142,7 @@ def settle(medium, floats, grid, tally, ps, p, layer):
         c_h = c[p.wavelength]
         shift = math.exp((c[r] - c_h) * dist)
         for j in range(n):
-            factor = math.exp(-(c[j] - c_h) * dist)
+            factor = exp(-(c[j] - c_h) * dist)
             k[j] *= factor
             g[j] *= factor * shift
         ps[free_path_at(grid)] = 0.0
@@ -238,7 +239,7 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     c_h = c[p.wavelength]
     if dist > 0.0:
         for j in range(n):
-            weight[j] = math.exp(-(c[j] - c_h) * dist)
+            weight[j] = exp(-(c[j] - c_h) * dist)
     else:   # settled (a collision whose emissions the packet carries on)
         for j in range(n):
             weight[j] = 1.0
@@ -412,7 +413,7 @@ def attenuate(medium, floats, grid, tally, ps, p, layer, dist):
     c = floats[row:row + n]
     if dist < math.inf:
         for j in range(n):
-            g[j] *= math.exp(-c[j] * dist)
+            g[j] *= exp(-c[j] * dist)
         return False
     settle(medium, floats, grid, tally, ps, p, layer)
     absorbed = spectral_at(grid, grid.budget + BUDGET_LAYERS + layer)
