@@ -129,52 +129,6 @@ def add_to_levels(est, floats, ints, grid, tally, share, z, tau_here, k, base, m
 
 
 @internal
-def direction_scores(est, floats, ints, grid, tally, share, work, z, tau, k, base, mu, first,
-                     last):
-    """add_to_levels() at the wavelengths first .. last - 1 at once (base[j - first] the light
-    each sends toward row k's direction): one level at a time over the wavelengths
-    (deposit_attenuated). One wavelength keeps add_to_levels and libm's exp, whose latency is
-    shorter."""
-    n = grid.n_wl
-    count = last - first
-    b = base[:count]
-    tau_j = tau[first:last]
-    row = est.n_dirs * n
-    local = grid.local + k * n
-    depths = grid.n_depths
-    if ints[est.in_water + k]:
-        for level in range(depths):
-            if floats[grid.level_z + level] <= z:
-                at = grid.level_tau + first * depths + level
-                deposit_attenuated(grid, tally, share, work, local + level * row, first, b,
-                                   tau_j, floats[at:at + count * depths:depths], mu, 1.0)
-    factor = floats[est.air_factor + k]
-    if factor > 0.0:
-        deposit_attenuated(grid, tally, share, work, local + depths * row, first, b, tau_j,
-                           tau_j[:0], mu, factor)
-
-
-@internal
-def deposit_attenuated(grid, tally, share, work, at, first, base, tau, above, mu, scale):
-    """tally.deposit_range() at score `at` of base[j] exp(-(tau[j] - above[j]) / mu) scale at
-    the wavelengths first + j, j < len(base): light sent from optical depth tau up to optical
-    depth above (a tally level's; none: above is empty, up to the surface) at direction
-    cosine mu. The values are made in a loop over the wavelengths with exp.py's exp, which LLVM
-    vectorises, in cap_scratch's value row (per wavelength with libm's exp, the exact
-    directions' scores were about a quarter of a 31-band run with one exact direction, perf;
-    this made such runs 3-7% shorter, interleaved A/B)."""
-    count = base.shape[0]
-    value = cap_scratch(grid, work)[0][:count]
-    if above.shape[0] == 0:
-        for j in range(count):
-            value[j] = base[j] * exp(-tau[j] / mu) * scale
-    else:
-        for j in range(count):
-            value[j] = base[j] * exp(-(tau[j] - above[j]) / mu) * scale
-    deposit_range(grid, tally, share, at, first, 1.0, value)
-
-
-@internal
 def from_air_through_rough(surface, floats, ax, ay, az, rng):
     """(ix, iy, iz, t): for the upward air direction o = (ax, ay, -az) (az > 0), an in-water
     direction of travel i whose light the rough surface sends into o, with t = 1, or t = 0
@@ -229,7 +183,6 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
     ux, uy, uz = p.ux, p.uy, p.uz
     if est.directions_on:
         rough = surface.delta == 0
-        base = cap_scratch(grid, work)[1]   # free until the cap scores
         for k in range(est.n_dirs):
             factor = floats[est.air_factor + k]
             if rough and factor > 0.0:
@@ -237,23 +190,17 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
                 if t > 0.0 and iz < 0.0:
                     layer_phase(medium, floats, ints, grid, layer, ux * ix + uy * iy + uz * iz,
                                 phase_j)
+                    at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                     for j in range(n):
-                        base[j] = weight[j] * phase_j[j]
-                    deposit_attenuated(grid, tally, share, work,
-                                       grid.local + (grid.n_depths * est.n_dirs + k) * n, 0,
-                                       base, tau, tau[:0], -iz, t / -iz * factor)
+                        deposit(grid, tally, share, at, j, weight[j] * phase_j[j] * t * math.exp(
+                            tau[j] / iz) / -iz * factor)
                 continue
             dx, dy, dz = direction(est, floats, k)
             mu = -dz
             layer_phase(medium, floats, ints, grid, layer, ux * dx + uy * dy + uz * dz, phase_j)
-            if n == 1:
-                add_to_levels(est, floats, ints, grid, tally, share, z, tau[0], k,
-                              weight[0] * phase_j[0] / mu, mu, 0)
-                continue
             for j in range(n):
-                base[j] = weight[j] * phase_j[j] / mu
-            direction_scores(est, floats, ints, grid, tally, share, work, z, tau, k, base, mu,
-                             0, n)
+                add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k,
+                              weight[j] * phase_j[j] / mu, mu, j)
     if est.cap_on:
         cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz,
                    ints[est.table_of_layer + layer], 0, n, rng)
@@ -449,8 +396,8 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
         spectral.bottom_weights(grid, floats, ps, p, weight)
     for j in range(n):
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
-    from_point(est, grid, surface, floats, ints, bp, tally, weights(grid, ps)[3], work, weight,
-               tau, floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng)
+    from_point(est, grid, surface, floats, ints, bp, tally, weights(grid, ps)[3], weight, tau,
+               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng)
 
 
 @internal
@@ -466,71 +413,61 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
     tau = scratch(grid, work)[1]   # the collision's (collision_depths)
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
     if est.directions_on:
-        directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, work,
-                              weight, tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
+        directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
+                              tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
     if est.cap_on:
         cap_scores(est, grid, floats, ints, tally, one_part, work, weight, tau, p.z, p.uz,
                    table, first, last, rng)
 
 
 @internal
-def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, work, weight,
-                          tau, z, ux, uy, uz, model, beta_at, first, last, rng):
+def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z,
+                          ux, uy, uz, model, beta_at, first, last, rng):
     """The radiance a point source at depth z (optical depths tau, weights `weight` at the
     wavelengths first .. last - 1, none elsewhere; toward() says what it sends, a bottom's
     BRDF or an emission's phase function) sends in the exact directions."""
     n = grid.n_wl
     rough = surface.delta == 0
-    base = cap_scratch(grid, work)[1][:last - first]   # free until the cap scores
-    w = weight[first:last]
     for k in range(est.n_dirs):
         factor = floats[est.air_factor + k]
         if rough and factor > 0.0:
             ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
             if t > 0.0 and iz < 0.0:
                 f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
-                for j in range(last - first):
-                    base[j] = w[j] * f
-                deposit_attenuated(grid, tally, share, work,
-                                   grid.local + (grid.n_depths * est.n_dirs + k) * n, first,
-                                   base, tau[first:last], base[:0], -iz, t * factor)
+                at = grid.local + (grid.n_depths * est.n_dirs + k) * n
+                for j in range(first, last):
+                    deposit(grid, tally, share, at, j,
+                            weight[j] * f * t * math.exp(tau[j] / iz) * factor)
             continue
         dx, dy, dz = direction(est, floats, k)
         f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
-        if n == 1:
-            add_to_levels(est, floats, ints, grid, tally, share, z, tau[0], k, weight[0] * f,
-                          -dz, 0)
-            continue
-        for j in range(last - first):
-            base[j] = w[j] * f
-        direction_scores(est, floats, ints, grid, tally, share, work, z, tau, k, base, -dz,
-                         first, last)
+        for j in range(first, last):
+            add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k, weight[j] * f,
+                          -dz, j)
 
 
 @internal
-def from_point(est, grid, surface, floats, ints, bp, tally, share, work, weight, tau, z, ux, uy,
-               uz, model, rng):
+def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z, ux, uy, uz,
+               model, rng):
     """The radiance the bottom (BRDF `model`) at depth z sends in the exact directions
     (directions_from_point), and the polar-cap average from one direction W drawn uniformly in
     the cap (an unbiased estimate of the cap average; f is bounded for every non-mirror BRDF),
     once in water and once for the air cap, through the surface's transmittance."""
     n = grid.n_wl
+    first, last = 0, n
     if est.directions_on:
-        directions_from_point(est, grid, surface, floats, ints, bp, tally, share, work, weight,
-                              tau, z, ux, uy, uz, model, 0, 0, n, rng)
+        directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau,
+                              z, ux, uy, uz, model, 0, first, last, rng)
     if est.cap_on:
-        base = cap_scratch(grid, work)[1]
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
         f = toward(model, bp, floats, 0, ux, uy, uz, ox, oy, -oz)
-        for j in range(n):
-            base[j] = weight[j] * f
-        depths = grid.n_depths
-        for level in range(depths):
-            if floats[grid.level_z + level] <= z:
-                at = grid.level_tau + level
-                deposit_attenuated(grid, tally, share, work, grid.cap + level * n, 0, base, tau,
-                                   floats[at:at + n * depths:depths], mu, 1.0)
+        for j in range(first, last):
+            taus = grid.level_tau + j * grid.n_depths
+            for level in range(grid.n_depths):
+                if floats[grid.level_z + level] <= z:
+                    deposit(grid, tally, share, grid.cap + level * n, j, weight[j] * f * math.exp(
+                        -(tau[j] - floats[taus + level]) / mu))
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
         if surface.delta == 0:
@@ -541,10 +478,9 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, work, weight,
             if t > 0.0 and iz < 0.0:
                 f = toward(model, bp, floats, 0, ux, uy, uz, ix, iy, iz) * t / (
                     n_water * n_water)
-                for j in range(n):
-                    base[j] = weight[j] * f
-                deposit_attenuated(grid, tally, share, work, grid.cap + depths * n, 0, base,
-                                   tau, tau[:0], -iz, 1.0)
+                for j in range(first, last):
+                    deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
+                            weight[j] * f * math.exp(tau[j] / iz))
             return
         sin_w = math.sqrt(max(0.0, 1.0 - mu_a * mu_a)) / n_water
         mu_w = math.sqrt(1.0 - sin_w * sin_w)
@@ -552,7 +488,6 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, work, weight,
         phi = 2.0 * math.pi * uniform(rng)
         f = toward(model, bp, floats, 0, ux, uy, uz, sin_w * math.cos(phi),
                    sin_w * math.sin(phi), -mu_w)
-        for j in range(n):
-            base[j] = weight[j] * f
-        deposit_attenuated(grid, tally, share, work, grid.cap + depths * n, 0, base, tau, tau[:0],
-                           mu_w, t / (n_water * n_water))
+        for j in range(first, last):
+            deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
+                    weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))
