@@ -35,7 +35,10 @@ collision is compiled at 13.3-13.8 s and trace_batch takes 9.2-9.5 s more: the t
 balanced, and what is left is the collision's and trace_batch's own compilation. Kernel
 e4782e8's vectorised cap scores, emission bands and carried shares added 4-5 s (one process:
 32.3 s against 37.5 s, trace_batch +1.8 s, the cap scores +1.3 s, the collision +0.7 s; ready(),
-interleaved: 23.7-24.8 s against 27.5-29.1 s). While trace_batch compiles, the child
+interleaved: 23.7-24.8 s against 27.5-29.1 s); kernel c484c1c's exp (kernel/exp.py, in five loops)
+added 1.2 s in one process (41.8 / 42.1 s against 42.7 / 43.6 s, interleaved), and the same exp
+in the exact directions' and the bottom's scores (seven inlined call sites) 5.5 s to ready(),
+so those were reverted (commit d8e354b). While trace_batch compiles, the child
 packs the scenes `oceanmc run` was given (child_main): a cold `oceanmc run CONFIG --photons
 20000` (interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2 s for
 deep_chlorophyll_maximum.yaml, 27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml, with
