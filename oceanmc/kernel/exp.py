@@ -19,8 +19,8 @@ of ln 2 as in fdlibm's e_exp.c):
   long instead of Horner's eleven;
 - 2^k from the exponent bits, as 2^floor(k/2) 2^(k - floor(k/2)) so that results below 2^-1022
   come out subnormal by the multiplication's own rounding.
-x > 709.78 gives inf, x < -745.14 gives 0, NaN gives NaN. tests/test_exp.py checks it against
-math.exp (within 2 units in the last place for normal results).
+x > 709.78 gives inf, x < -745.13 gives 0, NaN gives NaN. tests/test_exp.py checks it against
+math.exp (within 1 unit in the last place for normal results; 9% of them differ by 1).
 
 Under NUMBA_DISABLE_JIT=1 (the kernel as plain Python) exp is math.exp.
 """
