@@ -80,13 +80,17 @@ def case_fraunhofer(ctx: Ctx) -> None:
     line = {wavelength: i for i, wavelength in enumerate(LINES_NM)}
     depth = {d: i for i, d in enumerate(DEPTHS_M)}
 
+    def well_measured(chl, quantity, wavelength):
+        """The indices of the tally depths where the line's irradiance is well measured."""
+        rel = fillings[chl, quantity][1]
+        return [k for k in range(len(DEPTHS_M)) if rel[line[wavelength], k] < WELL_MEASURED]
+
     def measured(chl, quantity, wavelength, depths):
-        """The line's filling and its standard error at the depths where it is well
+        """The line's filling and its standard error at those of `depths` where it is well
         measured."""
-        f, rel = fillings[chl, quantity]
-        i = line[wavelength]
-        keep = [depth[d] for d in depths if rel[i, depth[d]] < WELL_MEASURED]
-        return f.value[i, keep], f.stderr[i, keep]
+        f = fillings[chl, quantity][0]
+        keep = [k for k in well_measured(chl, quantity, wavelength) if DEPTHS_M[k] in depths]
+        return f.value[line[wavelength], keep], f.stderr[line[wavelength], keep]
 
     def check(label, value, stderr, reference, atol):
         """A deterministic check of a filling (or a difference of two) against a band, its
@@ -111,14 +115,14 @@ def case_fraunhofer(ctx: Ctx) -> None:
     check(f"Chl {CLEAR:g}: the 656 nm line has filled in, in Ed at 50-100 m",
           *measured(CLEAR, "Ed", 656.0, [50.0, 75.0, 100.0]), 1.0, 0.1)
     # the changes with depth and between waters, with the jackknife error of the difference
-    f, rel = fillings[CLEAR, "Eu"]
-    ok = [k for k in range(len(DEPTHS_M)) if rel[line[518.0], k] < WELL_MEASURED]
+    f = fillings[CLEAR, "Eu"][0]
+    ok = well_measured(CLEAR, "Eu", 518.0)
     grow = f[line[518.0], ok[-1]] - f[line[518.0], 0]
     check(f"Chl {CLEAR:g}: the 518 nm line fills in with depth: its filling in Eu grows by "
           "at least 0.3 from 0- to the deepest well-measured depth", grow.value, grow.stderr,
           0.65, 0.35)
-    f, rel = fillings[GREEN, "Eu"]
-    ok = [k for k in range(len(DEPTHS_M)) if rel[line[518.0], k] < WELL_MEASURED]
+    f = fillings[GREEN, "Eu"][0]
+    ok = well_measured(GREEN, "Eu", 518.0)
     change = f[line[518.0], ok] - f[line[518.0], 0]
     check(f"Chl {GREEN:g}: the 518 nm line does not fill in with depth: its filling in Eu "
           "changes by less than 0.05 down to the deepest well-measured depth", change.value,

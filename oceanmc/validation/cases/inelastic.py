@@ -126,8 +126,8 @@ def case_inelastic(ctx: Ctx) -> None:
         "excitation wavelength equals the quantum yield times the share of the absorption "
         "that is phytoplankton's, two estimators of the same light (collisions, and the "
         "budget's absorption by settles); CDOM fluorescence (Chl 1, its case1 CDOM, alone) "
-        "likewise against Hawes's quantum yield Phi(l') times CDOM's share. The Fraunhofer lines' infilling with depth (Ge, "
-        "Gordon & Voss 1993): validation case fraunhofer.")
+        "likewise against Hawes's quantum yield Phi(l') times CDOM's share. The Fraunhofer "
+        "lines' infilling with depth (Ge, Gordon & Voss 1993): validation case fraunhofer.")
 
 
 def compare_thin_layer(ctx: Ctx) -> None:
