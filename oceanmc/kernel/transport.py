@@ -10,7 +10,10 @@ takes the component records it needs, the scene's float and int pools (kernel/re
 the packet (kernel/packet.py: a PACKET record p and its spectral state ps), which it updates in
 place. A collision that scatters runs one of the scene's collision channels (kernel/channels/).
 The event functions carry LLVM's alwaysinline attribute (kernel/compile.py): compiled once
-each, they are merged into the loop by LLVM, not copied by Numba.
+each, they are merged into the loop by LLVM, not copied by Numba. Large parts that not every
+scene runs (the inelastic emissions, the bottom's local estimates and BRDF sampling, the rough
+surface's sampling) are called by address, through the table `calls` (kernel/outline.py), so
+that they are compiled once, beside the loop.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -36,7 +39,7 @@ kept apart from the packet, so split copies do not copy it. One event's scratch 
 """
 import math
 
-from . import local_estimate, packet, spectral, weight_window
+from . import local_estimate, outline, packet, spectral, weight_window
 from .brdf import dispatch as brdf
 from .channels import dispatch as channels
 from .compile import batch, internal
@@ -100,19 +103,19 @@ def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
 
 
 @internal
-def facet_walk(surface, floats, p, rng):
+def facet_walk(surface, floats, p, rng, calls):
     """The rough surface in split()'s form: one sample of it (its table or its facet walk;
     weight f cos / pdf applied to p.w), as R = 1 into the reflected direction or R = 0 into the
     transmitted one, so that the delta surface's expected-value scoring applies to it
     unchanged."""
-    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, p.ux, p.uy, p.uz,
-                                                          uniform(rng), rng, floats)
+    ox, oy, oz, weight, transmitted = outline.surface_sample(
+        calls, (surface, p.ux, p.uy, p.uz, uniform(rng), rng, floats))
     p.w *= weight
     return (0.0 if transmitted else 1.0), ox, oy, oz, ox, oy, oz
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
@@ -122,7 +125,7 @@ def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, calls)
         w = p.w
     if ctrl.analog:
         reflected = r > 0.0 and uniform(rng) < r
@@ -206,7 +209,7 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
 
 @internal
 def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, stack, stack_ps,
-            n_stacked, p, layer, events, rng, rng_emitted):
+            n_stacked, p, layer, events, rng, rng_emitted, calls):
     """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
     channels/: they take their share of every wavelength and emit it, light the packet carries
     on or that waits on the stack in packets of its own), absorption (implicit: weight times
@@ -233,8 +236,10 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
     if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
-    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
-                              stack, stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted)
+    if medium.n_channels > 1:
+        n_stacked = outline.emit(calls, (medium, surface, ctrl, grid, est, floats, ints, tally,
+                                         work, stack, stack_ps, n_stacked, p, ps, layer,
+                                         carrying, rng_emitted))
     if carrying:
         spectral.hero_posterior(medium, floats, grid, ps, layer,
                                 work[grid.n_wl:2 * grid.n_wl])
@@ -277,7 +282,7 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -286,7 +291,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, calls)
     w = p.w
     if ctrl.analog:
         goes_on = r > 0.0 and uniform(rng) < r
@@ -312,7 +317,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
 
 @internal
 def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp, tally, ps,
-                      work, p, rng):
+                      work, p, rng, calls):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
@@ -321,11 +326,11 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
         score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)
         return False
     if est.directions_on or est.cap_on:
-        local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
-                                 ps, work, p, rng)
+        outline.at_bottom(calls, (est, grid, medium, bottom, surface, floats, ints, bp, tally,
+                                  ps, work, p, rng))
     u1 = uniform(rng)
     u2 = uniform(rng)
-    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2)
+    ux, uy, uz, rho = outline.brdf_reflect(calls, (bottom.model, bp, p.ux, p.uy, p.uz, u1, u2))
     p.ux = ux
     p.uy = uy
     p.uz = uz
@@ -381,7 +386,7 @@ def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_p
 @batch
 def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
                 floats, ints, n_photons, start, work_budget, rng, rng_emitted, beam_in,
-                tally_row, packet_row, stack, states, work):
+                tally_row, packet_row, stack, states, work, calls):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
@@ -446,7 +451,8 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
-        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng,
+                                           calls):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
@@ -471,15 +477,16 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                     alive, tau, n_stacked = collide(medium, surface, ctrl_row[p.seg], grid,
                                                     est, floats, ints, tally, ps, work, stack,
                                                     stack_ps, n_stacked, p, where, walk_events,
-                                                    draws, rng_emitted)
+                                                    draws, rng_emitted, calls)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
                         alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
-                                                 draws)
+                                                 draws, calls)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
-                                                  floats, ints, bp, tally, ps, work, p, draws)
+                                                  floats, ints, bp, tally, ps, work, p, draws,
+                                                  calls)
                     elif ctrl.depth_windows:
                         n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
                                                weight_window.copies(ctrl_row[p.seg], grid, p,

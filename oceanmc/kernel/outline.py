@@ -1,0 +1,139 @@
+"""Large parts of the photon loop that not every scene runs, called by address instead of being
+merged into the loop.
+
+Merged into trace_batch (kernel/compile.py's alwaysinline), a function's code is optimised and
+compiled by LLVM again in every function it is merged into (alone, in its event, in
+trace_batch), and trace_batch cannot be compiled until it is. Called through the address table
+`calls` (one int64 per function of OUTLINED, in that order: addresses()), each of these is
+compiled once, on its own, while trace_batch compiles (run/compiling.py), and its cached
+machine code is found by address. They are the inelastic channels' emissions (at a collision,
+in scenes with Raman scattering or fluorescence), the local estimates from the bottom, the
+BRDF's sampling (at every bottom reflection) and the rough surface's sampling (at every
+crossing of a rough surface). Measured (ready(), empty cache, 2 cores, 2026-11-27): 19.3-19.5 s
+against 29.4-31.1 s with all of them merged; one process, trace_batch 8.5 s against 18.5 s.
+
+A call by address costs about 6 ns more than merged code (a microbenchmark with this many
+arguments), small beside what each of these does per call; the feature rows of the speed bench
+(Lambertian bottom, rough surface) did not move. The local estimates at a collision stay merged
+into the collision: called by address they saved another 2-3 s of compilation but cost the
+bare-walk scene with the nadir-cap estimate about 10% of its photons/s (3.5 against 3.9-4.0
+million per second, interleaved runs), more than the call itself: merged, LLVM shares the
+collision's values with them.
+
+A call passes its arguments as a call to any other kernel function does (Numba's calling
+convention: arrays by their fields, records by pointer). The argument types at each call site
+are checked, when trace_batch is compiled, against the types the function is compiled for
+(signature(): from its parameters' names), so a call cannot pass what the function does not
+expect. The kernel raises no exceptions (error_model "numpy", no raise statements), so a call's
+status is not read. Under NUMBA_DISABLE_JIT the callers call the functions themselves."""
+from __future__ import annotations
+
+import inspect
+
+import numba
+import numpy as np
+from numba.core import cgutils, types
+from numba.core.errors import TypingError
+from numba.extending import intrinsic
+
+from . import local_estimate, records
+from .brdf import dispatch as brdf
+from .channels import dispatch as channels
+from .surface import dispatch as surface_bsdf
+
+# the functions called by address and their return types, in the order of the table `calls`
+OUTLINED = ((channels.emit, types.int64),
+            (local_estimate.at_bottom, types.none),
+            (brdf.reflect, types.UniTuple(types.float64, 4)),
+            (surface_bsdf.sample, types.Tuple((types.float64,) * 4 + (types.boolean,))))
+
+
+def argument_types() -> dict[str, types.Type]:
+    """The Numba type of each kernel argument by its name, the same in every kernel function
+    (a record by its component's name, its one-row array by name_row, the scene's pools
+    `floats` and `ints`, the packet p and its spectral state ps, ...)."""
+    f8 = numba.typeof(np.zeros(1))
+    found = {"floats": f8, "ints": numba.typeof(np.zeros(1, dtype=np.int64)),
+             "bp": f8, "tally": f8, "tally_row": f8, "ps": f8, "work": f8, "beam_in": f8,
+             "angles": f8, "states": numba.typeof(np.zeros((1, 1))),
+             "stack_ps": numba.typeof(np.zeros((1, 1))),
+             "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "rng_emitted": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "calls": numba.typeof(np.zeros(1, dtype=np.int64)),
+             "layer": types.int64, "events": types.int64, "wavelength": types.int64,
+             "n_stacked": types.int64, "target": types.int64, "level": types.int64,
+             "copies": types.int64, "component": types.int64, "tau": types.float64,
+             "w_scattered": types.float64, "from_sky": types.boolean,
+             "model": types.int64, "params": f8, "ux": types.float64, "uy": types.float64,
+             "uz": types.float64, "u": types.float64, "u1": types.float64, "u2": types.float64,
+             "carrying": types.boolean,
+             "n_photons": types.int64, "start": types.int64, "work_budget": types.int64,
+             "mu": types.float64}
+    for name, dtype in (("medium", records.MEDIUM), ("surface", records.SURFACE),
+                        ("bottom", records.BOTTOM), ("sky", records.SKY), ("grid", records.GRID),
+                        ("est", records.ESTIMATES), ("ctrl", records.ESTIMATOR),
+                        ("packet", records.PACKET)):
+        row = numba.typeof(np.zeros(1, dtype=dtype))
+        found[name], found[f"{name}_row"] = row.dtype, row
+    found["p"], found["stack"] = found["packet"], found["packet_row"]
+    return found
+
+
+def signature(function, found: dict[str, types.Type] | None = None) -> tuple:
+    """The argument types of a kernel function, from its parameters' names."""
+    found = argument_types() if found is None else found
+    return tuple(found[name] for name in inspect.signature(function.py_func).parameters)
+
+
+def address(function) -> int:
+    """Where the machine code of an outlined function starts (compiled for signature(), or
+    loaded from the disk cache, if it was not yet)."""
+    sig = signature(function)
+    function.compile(sig)
+    compiled = function.overloads[sig]
+    return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
+
+
+def addresses() -> np.ndarray:
+    """The table `calls` that trace_batch takes: OUTLINED's addresses, in order."""
+    if numba.config.DISABLE_JIT:
+        return np.arange(len(OUTLINED), dtype=np.int64)
+    return np.array([address(function) for function, _ in OUTLINED], dtype=np.int64)
+
+
+def _caller(slot: int):
+    """call(calls, args): OUTLINED[slot]'s function, at the address calls[slot], with the
+    arguments args (a tuple)."""
+    function, returns = OUTLINED[slot]
+    if numba.config.DISABLE_JIT:
+        def call(calls, args):
+            return function(*args)
+        return call
+
+    @intrinsic
+    def call(typingctx, calls, args):
+        expected = signature(function)
+        if tuple(args.types) != expected:
+            raise TypingError(f"outline: {function.py_func.__name__} called with "
+                              f"{tuple(args.types)}, compiled for {expected}")
+
+        def codegen(context, builder, sig, llargs):
+            calls_value, args_value = llargs
+            table = context.make_array(sig.args[0])(context, builder, calls_value)
+            at = builder.load(cgutils.gep_inbounds(builder, table.data, slot))
+            function_type = context.call_conv.get_function_type(returns, expected)
+            callee = builder.inttoptr(at, function_type.as_pointer())
+            returned = cgutils.alloca_once(builder, function_type.args[0].pointee)
+            builder.store(cgutils.get_null_value(function_type.args[0].pointee), returned)
+            exception = cgutils.alloca_once(builder, function_type.args[1].pointee)
+            values = cgutils.unpack_tuple(builder, args_value, len(expected))
+            packed = context.call_conv._get_arg_packer(expected).as_arguments(builder, values)
+            builder.call(callee, [returned, exception, *packed])
+            return context.get_returned_value(builder, returns, builder.load(returned))
+
+        return returns(calls, args), codegen
+    return call
+
+
+emit, at_bottom, brdf_reflect, surface_sample = (
+    _caller(slot) for slot in range(len(OUTLINED)))
