@@ -7,18 +7,18 @@ trace_batch), and trace_batch cannot be compiled until it is. Called through the
 `calls` (one int64 per function of OUTLINED, in that order: addresses()), each of these is
 compiled once, on its own, while trace_batch compiles (run/compiling.py), and its cached
 machine code is found by address. They are the inelastic channels' emissions (at a collision,
-in scenes with Raman scattering or fluorescence), the local estimates from the bottom, the
-BRDF's sampling (at every bottom reflection) and the rough surface's sampling (at every
-crossing of a rough surface). Measured (ready(), empty cache, 2 cores, 2026-11-27): 19.3-19.5 s
-against 29.4-31.1 s with all of them merged; one process, trace_batch 8.5 s against 18.5 s.
+in scenes with Raman scattering or fluorescence), the local estimates from the bottom and the
+BRDF's sampling (at every bottom reflection). Measured (ready(), empty cache, 2 cores,
+2026-11-27, interleaved): 20.4-20.8 s against 34.1-34.6 s with all of them merged (earlier,
+on a quieter machine, 29.4-31.1 s); one process, trace_batch 8.5 s against 18.5 s.
 
 A call by address costs about 6 ns more than merged code (a microbenchmark with this many
-arguments), small beside what each of these does per call; the feature rows of the speed bench
-(Lambertian bottom, rough surface) did not move. The local estimates at a collision stay merged
-into the collision: called by address they saved another 2-3 s of compilation but cost the
-bare-walk scene with the nadir-cap estimate about 10% of its photons/s (3.5 against 3.9-4.0
-million per second, interleaved runs), more than the call itself: merged, LLVM shares the
-collision's values with them.
+arguments), small beside what each of these does per call. Two more were tried and kept
+merged, for what they cost at run time beyond the call itself (merged, LLVM shares the
+caller's values with them): the local estimates at a collision (another 2-3 s less
+compilation, but the bare-walk scene with the nadir-cap estimate ran at 3.5 instead of 3.9-4.0
+million photons/s, interleaved) and the rough surface's sampling (0.3 s less compilation;
+3.5-4.0 against 3.9-4.2 million photons/s on the bare-walk scene at 5 m/s, interleaved).
 
 A call passes its arguments as a call to any other kernel function does (Numba's calling
 convention: arrays by their fields, records by pointer). The argument types at each call site
@@ -39,13 +39,11 @@ from numba.extending import intrinsic
 from . import local_estimate, records
 from .brdf import dispatch as brdf
 from .channels import dispatch as channels
-from .surface import dispatch as surface_bsdf
 
 # the functions called by address and their return types, in the order of the table `calls`
 OUTLINED = ((channels.emit, types.int64),
             (local_estimate.at_bottom, types.none),
-            (brdf.reflect, types.UniTuple(types.float64, 4)),
-            (surface_bsdf.sample, types.Tuple((types.float64,) * 4 + (types.boolean,))))
+            (brdf.reflect, types.UniTuple(types.float64, 4)))
 
 
 def argument_types() -> dict[str, types.Type]:
@@ -65,7 +63,7 @@ def argument_types() -> dict[str, types.Type]:
              "copies": types.int64, "component": types.int64, "tau": types.float64,
              "w_scattered": types.float64, "from_sky": types.boolean,
              "model": types.int64, "params": f8, "ux": types.float64, "uy": types.float64,
-             "uz": types.float64, "u": types.float64, "u1": types.float64, "u2": types.float64,
+             "uz": types.float64, "u1": types.float64, "u2": types.float64,
              "carrying": types.boolean,
              "n_photons": types.int64, "start": types.int64, "work_budget": types.int64,
              "mu": types.float64}
@@ -135,5 +133,5 @@ def _caller(slot: int):
     return call
 
 
-emit, at_bottom, brdf_reflect, surface_sample = (
+emit, at_bottom, brdf_reflect = (
     _caller(slot) for slot in range(len(OUTLINED)))

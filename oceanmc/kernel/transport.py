@@ -11,9 +11,9 @@ the packet (kernel/packet.py: a PACKET record p and its spectral state ps), whic
 place. A collision that scatters runs one of the scene's collision channels (kernel/channels/).
 The event functions carry LLVM's alwaysinline attribute (kernel/compile.py): compiled once
 each, they are merged into the loop by LLVM, not copied by Numba. Large parts that not every
-scene runs (the inelastic emissions, the bottom's local estimates and BRDF sampling, the rough
-surface's sampling) are called by address, through the table `calls` (kernel/outline.py), so
-that they are compiled once, beside the loop.
+scene runs (the inelastic emissions, the bottom's local estimates and BRDF sampling) are
+called by address, through the table `calls` (kernel/outline.py), so that they are compiled
+once, beside the loop.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -103,19 +103,19 @@ def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
 
 
 @internal
-def facet_walk(surface, floats, p, rng, calls):
+def facet_walk(surface, floats, p, rng):
     """The rough surface in split()'s form: one sample of it (its table or its facet walk;
     weight f cos / pdf applied to p.w), as R = 1 into the reflected direction or R = 0 into the
     transmitted one, so that the delta surface's expected-value scoring applies to it
     unchanged."""
-    ox, oy, oz, weight, transmitted = outline.surface_sample(
-        calls, (surface, p.ux, p.uy, p.uz, uniform(rng), rng, floats))
+    ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, p.ux, p.uy, p.uz,
+                                                          uniform(rng), rng, floats)
     p.w *= weight
     return (0.0 if transmitted else 1.0), ox, oy, oz, ox, oy, oz
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls):
+def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
@@ -125,7 +125,7 @@ def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls):
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, calls)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
         w = p.w
     if ctrl.analog:
         reflected = r > 0.0 and uniform(rng) < r
@@ -282,7 +282,7 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls):
+def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -291,7 +291,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, calls
     if surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, calls)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
     w = p.w
     if ctrl.analog:
         goes_on = r > 0.0 and uniform(rng) < r
@@ -451,8 +451,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         from_air = i < 0 or from_sky or not beam_once
         if grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
-        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng,
-                                           calls):
+        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
@@ -482,7 +481,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
                         alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
-                                                 draws, calls)
+                                                 draws)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
                                                   floats, ints, bp, tally, ps, work, p, draws,
