@@ -23,8 +23,8 @@ Python, with the alwaysinline attribute (the phase function's sampling and evalu
 measured +18% photons/s with an exact-direction local estimate, +14% with the nadir-cap one,
 one run each).
 
-`outlined`: large parts of the loop that not every scene runs (kernel/outline.py), which it
-calls by address: each compiled once, on its own, not merged into its callers.
+`outlined`: parts of the loop that it calls by address (kernel/outline.py): each compiled
+once, on its own, not merged into its callers.
 
 `batch`: the photon loop's entry point (transport.trace_batch), which releases the GIL so that
 batches run in parallel threads. `setup`: functions run once per scene or by tests, which may

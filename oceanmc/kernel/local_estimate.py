@@ -31,7 +31,7 @@ import math
 
 from . import spectral
 from .brdf import dispatch as brdf
-from .compile import internal, kernel, outlined
+from .compile import internal, kernel
 from .exp import exp
 from .geometry import from_angles
 from .packet import weights
@@ -382,7 +382,7 @@ def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz):
     return quadratic.evaluate(floats[beta_at:], ux * ox + uy * oy + uz * oz) / -oz
 
 
-@outlined
+@internal
 def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng):
     """Packet p meets the bottom: the reflected radiance w f(wi, W) T in the exact directions
     and the polar-cap averages (from_point), at every wavelength (one BRDF shape, each

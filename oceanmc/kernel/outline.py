@@ -1,24 +1,25 @@
-"""Large parts of the photon loop that not every scene runs, called by address instead of being
-merged into the loop.
+"""Parts of the photon loop called by address instead of merged into it: the inelastic
+channels' emissions (channels.emit), the largest part of the kernel that not every scene runs.
 
 Merged into trace_batch (kernel/compile.py's alwaysinline), a function's code is optimised and
 compiled by LLVM again in every function it is merged into (alone, in its event, in
 trace_batch), and trace_batch cannot be compiled until it is. Called through the address table
-`calls` (one int64 per function of OUTLINED, in that order: addresses()), each of these is
-compiled once, on its own, while trace_batch compiles (run/compiling.py), and its cached
-machine code is found by address. They are the inelastic channels' emissions (at a collision,
-in scenes with Raman scattering or fluorescence), the local estimates from the bottom and the
-BRDF's sampling (at every bottom reflection). Measured (ready(), empty cache, 2 cores,
-2026-11-27, interleaved): 20.4-20.8 s against 34.1-34.6 s with all of them merged (earlier,
-on a quieter machine, 29.4-31.1 s); one process, trace_batch 8.5 s against 18.5 s.
+`calls` (one int64 per function of OUTLINED, in that order: addresses()), it is compiled once,
+on its own, while trace_batch compiles (run/compiling.py), and its cached machine code is found
+by address. Measured (ready(), empty cache, 2 cores, 2026-11-27, interleaved): 23.1 / 25.2 s
+against 29.8 / 29.3 s merged.
 
 A call by address costs about 6 ns more than merged code (a microbenchmark with this many
-arguments), small beside what each of these does per call. Two more were tried and kept
-merged, for what they cost at run time beyond the call itself (merged, LLVM shares the
-caller's values with them): the local estimates at a collision (another 2-3 s less
-compilation, but the bare-walk scene with the nadir-cap estimate ran at 3.5 instead of 3.9-4.0
-million photons/s, interleaved) and the rough surface's sampling (0.3 s less compilation;
-3.5-4.0 against 3.9-4.2 million photons/s on the bare-walk scene at 5 m/s, interleaved).
+arguments), nothing beside an emission's work. Other parts were called by address and merged
+again, for what they cost at run time beyond the call itself (merged, LLVM shares the loop's
+values with them; an opaque call on a path of the loop costs the loop even where it is not
+taken): the bottom's local estimates and BRDF sampling (ready() 20.4-20.8 s, but
+configs/default.yaml ran at 183-223 against 233-259 thousand photons per CPU-second, and the
+bare-walk scene with an exact-nadir estimate, where the black bottom is never called, at
+1.9-3.0 against 2.9-3.3 million photons/s, interleaved), the local estimates at a collision
+(2-3 s less compilation; the nadir-cap scene 3.5 against 3.9-4.0 million photons/s) and the
+rough surface's sampling (0.3 s less; the bare-walk scene at 5 m/s 3.5-4.0 against 3.9-4.2
+million photons/s).
 
 A call passes its arguments as a call to any other kernel function does (Numba's calling
 convention: arrays by their fields, records by pointer). The argument types at each call site
@@ -36,14 +37,11 @@ from numba.core import cgutils, types
 from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
-from . import local_estimate, records
-from .brdf import dispatch as brdf
+from . import records
 from .channels import dispatch as channels
 
 # the functions called by address and their return types, in the order of the table `calls`
-OUTLINED = ((channels.emit, types.int64),
-            (local_estimate.at_bottom, types.none),
-            (brdf.reflect, types.UniTuple(types.float64, 4)))
+OUTLINED = ((channels.emit, types.int64),)
 
 
 def argument_types() -> dict[str, types.Type]:
@@ -62,8 +60,6 @@ def argument_types() -> dict[str, types.Type]:
              "n_stacked": types.int64, "target": types.int64, "level": types.int64,
              "copies": types.int64, "component": types.int64, "tau": types.float64,
              "w_scattered": types.float64, "from_sky": types.boolean,
-             "model": types.int64, "params": f8, "ux": types.float64, "uy": types.float64,
-             "uz": types.float64, "u1": types.float64, "u2": types.float64,
              "carrying": types.boolean,
              "n_photons": types.int64, "start": types.int64, "work_budget": types.int64,
              "mu": types.float64}
@@ -133,5 +129,4 @@ def _caller(slot: int):
     return call
 
 
-emit, at_bottom, brdf_reflect = (
-    _caller(slot) for slot in range(len(OUTLINED)))
+emit, = (_caller(slot) for slot in range(len(OUTLINED)))

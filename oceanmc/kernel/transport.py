@@ -10,10 +10,9 @@ takes the component records it needs, the scene's float and int pools (kernel/re
 the packet (kernel/packet.py: a PACKET record p and its spectral state ps), which it updates in
 place. A collision that scatters runs one of the scene's collision channels (kernel/channels/).
 The event functions carry LLVM's alwaysinline attribute (kernel/compile.py): compiled once
-each, they are merged into the loop by LLVM, not copied by Numba. Large parts that not every
-scene runs (the inelastic emissions, the bottom's local estimates and BRDF sampling) are
-called by address, through the table `calls` (kernel/outline.py), so that they are compiled
-once, beside the loop.
+each, they are merged into the loop by LLVM, not copied by Numba. The inelastic emissions,
+which not every scene runs, are called by address, through the table `calls`
+(kernel/outline.py), so that they are compiled once, beside the loop.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -317,7 +316,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
 
 @internal
 def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp, tally, ps,
-                      work, p, rng, calls):
+                      work, p, rng):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
@@ -326,11 +325,11 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
         score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)
         return False
     if est.directions_on or est.cap_on:
-        outline.at_bottom(calls, (est, grid, medium, bottom, surface, floats, ints, bp, tally,
-                                  ps, work, p, rng))
+        local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
+                                 ps, work, p, rng)
     u1 = uniform(rng)
     u2 = uniform(rng)
-    ux, uy, uz, rho = outline.brdf_reflect(calls, (bottom.model, bp, p.ux, p.uy, p.uz, u1, u2))
+    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2)
     p.ux = ux
     p.uy = uy
     p.uz = uz
@@ -484,8 +483,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                                                  draws)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
-                                                  floats, ints, bp, tally, ps, work, p, draws,
-                                                  calls)
+                                                  floats, ints, bp, tally, ps, work, p, draws)
                     elif ctrl.depth_windows:
                         n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
                                                weight_window.copies(ctrl_row[p.seg], grid, p,

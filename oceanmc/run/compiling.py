@@ -10,11 +10,10 @@ Numba compiles one function at a time, so on a machine with two or more cores th
 is compiled in two processes that meet in the disk cache (parts()): a child process compiles
 the local estimates at a collision, the events at the surface and the bottom, the free flight
 and trace_batch's other callees, then the functions the loop calls by address
-(kernel/outline.py: the inelastic emissions, the bottom's local estimates, the BRDF's
-sampling), while this one compiles the collision (its elastic channel first)
-and then trace_batch, which loads the child's part from the cache, and finally loads the
-functions called by address. If the child fails or is slow, this process compiles what it
-lacks: the result is the same.
+(kernel/outline.py: the inelastic emissions), while this one compiles the collision (its
+elastic channel first) and then trace_batch, which loads the child's part from the cache, and
+finally loads the functions called by address. If the child fails or is slow, this process
+compiles what it lacks: the result is the same.
 
 trace_batch's own compilation is the longest single step and cannot be shared out: Numba links
 every callee's optimised LLVM IR into the entry point's module, then optimises it again (7.7 s,
@@ -41,22 +40,20 @@ e4782e8's vectorised cap scores, emission bands and carried shares added 4-5 s (
 interleaved: 23.7-24.8 s against 27.5-29.1 s); kernel c484c1c's exp (kernel/exp.py, in five loops)
 added 1.2 s in one process (41.8 / 42.1 s against 42.7 / 43.6 s, interleaved), and the same exp
 in the exact directions' and the bottom's scores (seven inlined call sites) 5.5 s to ready(),
-so those were reverted (commit d8e354b). Calling the large optional parts by address
-(kernel/outline.py) took ready() from 34.1-34.6 s to 20.4-20.8 s (empty cache, 2026-11-27,
-interleaved; on a quieter machine earlier, 29.4-31.1 s to 19.3-19.5 s with the rough surface's
-sampling called by address too; one process: every part 48.5 -> 34.8 s, trace_batch 18.5 -> 8.5
-s; the local estimates at a collision are compiled first in the child, so that the collision
-here finds them in the cache: 21.7 s without that order) and a cold `oceanmc run CONFIG
---photons 20000` from 33.9 / 34.3 s to 26.6 / 27.3 s (windy_case1.yaml), 32.6 / 32.7 s to 25.7 /
-25.9 s (deep_chlorophyll_maximum.yaml) and 32.7 / 34.1 s to 23.1 / 23.6 s
-(raman_fluorescence.yaml), interleaved. The child then packs the scenes `oceanmc run` was given
-(child_main), so that their tables are in the disk caches when this process packs them: when it
-packed them while trace_batch compiled, a cold `oceanmc run CONFIG --photons 20000`
-(interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2 s for deep_chlorophyll_maximum.yaml,
-27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml, with the same results bit for bit;
-packing them before the functions called by address made no difference (windy_case1.yaml 26.8 /
-27.1 s against 26.2 / 26.4 s, deep_chlorophyll_maximum.yaml 26.0 / 26.8 s against 26.4 / 26.7
-s).
+so those were reverted (commit d8e354b). Calling the inelastic emissions by address
+(kernel/outline.py) took ready() from 29.8 / 29.3 s to 23.1 / 25.2 s (empty cache, 2026-11-27,
+interleaved; calling the bottom's local estimates and BRDF sampling by address as well:
+20.4-20.8 s against 34.1-34.6 s, one process: every part 48.5 -> 34.8 s, trace_batch 18.5 -> 8.5
+s, but runs with a bottom or an exact direction 13-20% slower, kernel/outline.py). The local
+estimates at a collision are compiled first in the child, so that the collision here finds them
+in the cache (with the bottom's parts called by address: 21.7 s without that order). The child
+then packs the scenes `oceanmc run` was given (child_main), so that their tables are in the disk
+caches when this process packs them: when it packed them while trace_batch compiled, a cold
+`oceanmc run CONFIG --photons 20000` (interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2
+s for deep_chlorophyll_maximum.yaml, 27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml,
+with the same results bit for bit; packing them before the functions called by address made no
+difference (windy_case1.yaml 26.8 / 27.1 s against 26.2 / 26.4 s, deep_chlorophyll_maximum.yaml
+26.0 / 26.8 s against 26.4 / 26.7 s, with the bottom's parts called by address).
 (trace_batch at LLVM level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code
 then keeps dynamic globals, which Numba will not cache: every run would compile again.)
 """
