@@ -76,7 +76,8 @@ def argument_types() -> dict[str, types.Type]:
 def signature(function, found: dict[str, types.Type] | None = None) -> tuple:
     """The argument types of a kernel function, from its parameters' names."""
     found = argument_types() if found is None else found
-    return tuple(found[name] for name in inspect.signature(function.py_func).parameters)
+    python = getattr(function, "py_func", function)   # a plain function under NUMBA_DISABLE_JIT
+    return tuple(found[name] for name in inspect.signature(python).parameters)
 
 
 def address(function) -> int:
@@ -129,4 +130,4 @@ def _caller(slot: int):
     return call
 
 
-emit, = (_caller(slot) for slot in range(len(OUTLINED)))
+emit = _caller(0)   # OUTLINED[0]
