@@ -23,9 +23,6 @@ Python, with the alwaysinline attribute (the phase function's sampling and evalu
 measured +18% photons/s with an exact-direction local estimate, +14% with the nadir-cap one,
 one run each).
 
-`outlined`: parts of the loop that it calls by address (kernel/outline.py): each compiled
-once, on its own, not merged into its callers.
-
 `batch`: the photon loop's entry point (transport.trace_batch), which releases the GIL so that
 batches run in parallel threads. `setup`: functions run once per scene or by tests, which may
 allocate.
@@ -83,7 +80,6 @@ def _jit(**options):
 
 kernel = _jit(_nrt=False, no_cfunc_wrapper=True)
 internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True)
-outlined = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 hot = _jit(_nrt=False, no_cfunc_wrapper=True, forceinline=True)
 batch = _jit(_nrt=False, nogil=True)
 setup = _jit()

@@ -10,9 +10,7 @@ takes the component records it needs, the scene's float and int pools (kernel/re
 the packet (kernel/packet.py: a PACKET record p and its spectral state ps), which it updates in
 place. A collision that scatters runs one of the scene's collision channels (kernel/channels/).
 The event functions carry LLVM's alwaysinline attribute (kernel/compile.py): compiled once
-each, they are merged into the loop by LLVM, not copied by Numba. The inelastic emissions,
-which not every scene runs, are called by address, through the table `calls`
-(kernel/outline.py), so that they are compiled once, beside the loop.
+each, they are merged into the loop by LLVM, not copied by Numba.
 
 Estimator (estimator.analog false, the default): implicit capture (a collision keeps the packet
 and multiplies its weight by the single-scattering albedo), expected values at the surface
@@ -38,7 +36,7 @@ kept apart from the packet, so split copies do not copy it. One event's scratch 
 """
 import math
 
-from . import local_estimate, outline, packet, spectral, weight_window
+from . import local_estimate, packet, spectral, weight_window
 from .brdf import dispatch as brdf
 from .channels import dispatch as channels
 from .compile import batch, internal
@@ -208,7 +206,7 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
 
 @internal
 def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, stack, stack_ps,
-            n_stacked, p, layer, events, rng, rng_emitted, calls):
+            n_stacked, p, layer, events, rng, rng_emitted):
     """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
     channels/: they take their share of every wavelength and emit it, light the packet carries
     on or that waits on the stack in packets of its own), absorption (implicit: weight times
@@ -235,10 +233,8 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
     if estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
                                     p, layer, p.w * albedo, rng)
-    if medium.n_channels > 1:
-        n_stacked = outline.emit(calls, (medium, surface, ctrl, grid, est, floats, ints, tally,
-                                         work, stack, stack_ps, n_stacked, p, ps, layer,
-                                         carrying, rng_emitted))
+    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
+                              stack, stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted)
     if carrying:
         spectral.hero_posterior(medium, floats, grid, ps, layer,
                                 work[grid.n_wl:2 * grid.n_wl])
@@ -385,7 +381,7 @@ def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_p
 @batch
 def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
                 floats, ints, n_photons, start, work_budget, rng, rng_emitted, beam_in,
-                tally_row, packet_row, stack, states, work, calls):
+                tally_row, packet_row, stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
@@ -475,7 +471,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                     alive, tau, n_stacked = collide(medium, surface, ctrl_row[p.seg], grid,
                                                     est, floats, ints, tally, ps, work, stack,
                                                     stack_ps, n_stacked, p, where, walk_events,
-                                                    draws, rng_emitted, calls)
+                                                    draws, rng_emitted)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:

@@ -6,15 +6,13 @@ version and machine. ready() compiles them in a helper thread (LLVM releases the
 the main thread can say what is happening every few seconds on stderr and stop at once on
 Ctrl-C (KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
 
-Numba compiles one function at a time, so on a machine with two or more cores the photon loop
-is compiled in two processes that meet in the disk cache (parts()): a child process compiles
-the local estimates at a collision, the events at the surface and the bottom, the free flight
-and trace_batch's other callees, then the functions the loop calls by address
-(kernel/outline.py: the inelastic emissions), while this one compiles the collision (its
-elastic channel first) and then trace_batch, which loads the child's part from the cache, and
-finally loads the functions called by address. If the child fails or is slow, this process
-compiles what it lacks: the result is the same.
-
+Numba compiles one function at a time, so on a machine with two or more cores the photon loop's
+events are compiled in two processes that meet in the disk cache: a child process compiles the
+events at the surface and the bottom (the rough sea's facet walk, the BRDFs, the local
+estimates from the bottom), the free flight and trace_batch's other callees while this one
+compiles the collision (the phase functions, the inelastic channels, the local estimates from a
+collision); trace_batch, compiled last, then loads the child's part from the cache. If the
+child fails or is slow, trace_batch compiles that part itself: the result is the same.
 trace_batch's own compilation is the longest single step and cannot be shared out: Numba links
 every callee's optimised LLVM IR into the entry point's module, then optimises it again (7.7 s,
 LLVM's pass timings) and generates machine code for all of it (4.8 s), after each callee did
@@ -40,25 +38,34 @@ e4782e8's vectorised cap scores, emission bands and carried shares added 4-5 s (
 interleaved: 23.7-24.8 s against 27.5-29.1 s); kernel c484c1c's exp (kernel/exp.py, in five loops)
 added 1.2 s in one process (41.8 / 42.1 s against 42.7 / 43.6 s, interleaved), and the same exp
 in the exact directions' and the bottom's scores (seven inlined call sites) 5.5 s to ready(),
-so those were reverted (commit d8e354b). Calling the inelastic emissions by address
-(kernel/outline.py) took ready() from 29.8 / 29.3 s to 23.1 / 25.2 s (empty cache, 2026-11-27,
-interleaved; calling the bottom's local estimates and BRDF sampling by address as well:
-20.4-20.8 s against 34.1-34.6 s, one process: every part 48.5 -> 34.8 s, trace_batch 18.5 -> 8.5
-s, but runs with a bottom or an exact direction 13-20% slower, kernel/outline.py). The local
-estimates at a collision are compiled first in the child, so that the collision here finds them
-in the cache (with the bottom's parts called by address: 21.7 s without that order). The child
-then packs the scenes `oceanmc run` was given (child_main), so that their tables are in the disk
-caches when this process packs them: when it packed them while trace_batch compiled, a cold
-`oceanmc run CONFIG --photons 20000` (interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2
-s for deep_chlorophyll_maximum.yaml, 27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml,
-with the same results bit for bit; packing them before the functions called by address made no
-difference (windy_case1.yaml 26.8 / 27.1 s against 26.2 / 26.4 s, deep_chlorophyll_maximum.yaml
-26.0 / 26.8 s against 26.4 / 26.7 s, with the bottom's parts called by address).
+so those were reverted (commit d8e354b). While trace_batch compiles, the child
+packs the scenes `oceanmc run` was given (child_main): a cold `oceanmc run CONFIG --photons
+20000` (interleaved, twice) took 27.1-27.9 s instead of 30.0-30.2 s for
+deep_chlorophyll_maximum.yaml, 27.8-28.6 s instead of 30.6-31.7 s for windy_case1.yaml, with
+the same results bit for bit (the tables come from the disk caches).
+Calling parts of the loop by address instead of merging them (commits eadf565-2b12516,
+kernel/outline.py: a table of the parts' addresses passed to trace_batch, a Numba intrinsic per
+part calling its cached machine code with Numba's calling convention, each part compiled once,
+beside trace_batch; reverted): with the inelastic emissions so called, ready() took
+23.1 / 25.2 s against 29.8 / 29.3 s and speed.md's cold starts were 24.6-26.8 s, with every
+output bit for bit the same, but the inelastic bench's scene (1 thread, CPU time, 7 interleaved
+pairs) ran at a median 27.5 against 31.2 thousand photons/s, and the bench's Raman and
+fluorescence run at 73,826 against 83,936 photons/s; with the bottom's local estimates and BRDF
+sampling so called as well, ready() took 20.4-20.8 s against 34.1-34.6 s, but
+configs/default.yaml ran at 183-223 against 233-259 thousand photons per CPU-second and the
+bare-walk scene with an exact-nadir estimate (its black bottom never calls them) at 1.9-3.0
+against 2.9-3.3 million photons/s; the local estimates at a collision (2-3 s less) cost the
+nadir-cap scene 10% of its photons/s, the rough surface's sampling (0.3 s less) the 5 m/s scene
+9%. The call itself costs about 6 ns (a microbenchmark with 14 arguments); the rest is an opaque
+call on a path of the loop, taken or not, which LLVM must assume writes the packet and the
+streams. Run time every run against 5 s once: not kept. (Numba's own inlining, inline='always',
+instead of LLVM's: 151 s for one process against 48.5 s.)
 (trace_batch at LLVM level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code
 then keeps dynamic globals, which Numba will not cache: every run would compile again.)
 """
 from __future__ import annotations
 
+import inspect
 import os
 import subprocess
 import sys
@@ -68,10 +75,10 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 import numba
+import numpy as np
 from numba.core.config import _OptLevel
 
-from ..kernel import local_estimate, outline, sources, spectral, transport
-from ..kernel.channels import dispatch as channels
+from ..kernel import records, sources, spectral, transport
 from ..kernel.compile import CACHE_DIR
 from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
@@ -90,25 +97,52 @@ class CompileInterrupted(Exception):
     """The user asked to stop while the kernel was compiling; nothing was traced."""
 
 
+def _argument_types() -> dict[str, numba.types.Type]:
+    """The Numba type of each kernel argument by its name, the same in every kernel function
+    (a record by its component's name, its one-row array by name_row, the scene's pools
+    `floats` and `ints`, the packet p and its spectral state ps, ...)."""
+    f8 = numba.typeof(np.zeros(1))
+    types = {"floats": f8, "ints": numba.typeof(np.zeros(1, dtype=np.int64)),
+             "bp": f8, "tally": f8, "tally_row": f8, "ps": f8, "work": f8, "beam_in": f8,
+             "angles": f8, "states": numba.typeof(np.zeros((1, 1))),
+             "stack_ps": numba.typeof(np.zeros((1, 1))),
+             "rng": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "rng_emitted": numba.typeof(np.zeros(1, dtype=np.uint64)),
+             "layer": numba.int64, "events": numba.int64, "wavelength": numba.int64,
+             "n_stacked": numba.int64, "target": numba.int64, "level": numba.int64,
+             "copies": numba.int64, "component": numba.int64, "tau": numba.float64,
+             "from_sky": numba.boolean,
+             "n_photons": numba.int64, "start": numba.int64, "work_budget": numba.int64,
+             "mu": numba.float64}
+    for name, dtype in (("medium", records.MEDIUM), ("surface", records.SURFACE),
+                        ("bottom", records.BOTTOM), ("sky", records.SKY), ("grid", records.GRID),
+                        ("est", records.ESTIMATES), ("ctrl", records.ESTIMATOR),
+                        ("packet", records.PACKET)):
+        row = numba.typeof(np.zeros(1, dtype=dtype))
+        types[name], types[f"{name}_row"] = row.dtype, row
+    types["p"], types["stack"] = types["packet"], types["packet_row"]
+    return types
+
+
+def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
+    """The argument types of a kernel function, from its parameters' names."""
+    return tuple(types[name] for name in inspect.signature(function.py_func).parameters)
+
+
 def parts() -> dict[str, list[tuple]]:
     """(dispatcher, argument types) to compile, in order: `events` (in the child process when
-    there is one: the local estimates at a collision, the walk's events but the collision, and
-    trace_batch's other callees), `collision` (its elastic channel, then the collision, which
-    finds its local estimates in the cache) and `entry` (the entry points, trace_batch first)
-    here, and `outlined` (the functions called by address, kernel/outline.py: in the child
-    after its events, loaded from the cache here). A function compiled in the child with other
-    argument types than its caller here calls it with would only be compiled again here, at no
-    other cost (checked once: none is)."""
-    types = outline.argument_types()
-    return {name: [(f, outline.signature(f, types)) for f in functions] for name, functions in (
-        ("events", (local_estimate.at_collision, transport.enter_from_air,
-                    transport.leave_or_reflect, transport.reflect_at_bottom,
-                    transport.free_flight, transport.cross_plane, transport.after_reflection,
-                    transport.split_into, sources.sky_direction, spectral.start,
-                    component_density, transmittance)),
-        ("collision", (channels.scatter, transport.collide)),
-        ("entry", (trace_batch, component_density, transmittance)),
-        ("outlined", tuple(f for f, _ in outline.OUTLINED)))}
+    there is one: the walk's events but the collision, and trace_batch's other callees),
+    `collision` and `entry` (the entry points, trace_batch first) here. A function compiled in
+    `events` with other argument types than trace_batch calls it with would only be compiled
+    again here, at no other cost (checked once: none is)."""
+    types = _argument_types()
+    return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
+        ("events", (transport.enter_from_air, transport.leave_or_reflect,
+                    transport.reflect_at_bottom, transport.free_flight, transport.cross_plane,
+                    transport.after_reflection, transport.split_into, sources.sky_direction,
+                    spectral.start, component_density, transmittance)),
+        ("collision", (transport.collide,)),
+        ("entry", (trace_batch, component_density, transmittance)))}
 
 
 def compile_part(name: str) -> None:
@@ -123,8 +157,7 @@ def compile_part(name: str) -> None:
 
 
 def _in_cache() -> bool:
-    """Whether the disk cache already holds the photon loop's entry point (then loading the
-    loop takes 0.3 s)."""
+    """Whether the disk cache already holds the photon loop (then loading it takes 0.3 s)."""
     return any(CACHE_DIR.rglob(f"transport.{trace_batch.__name__}-*.nbi"))
 
 
@@ -133,13 +166,12 @@ EVENTS_COMPILED = "events compiled"
 
 def child_main(scene_files: list[str]) -> None:
     """The compiling child process: compiles the part `events` into the shared cache, says so
-    on stdout, compiles the part `outlined` while the parent compiles trace_batch, then packs
-    the scenes of scene_files (their tables, cached on disk, are then the parent's for the
-    asking: a profile's or a windy sea's take seconds to build). A scene it cannot pack is left
-    to the parent, which reports why."""
+    on stdout, then packs the scenes of scene_files while the parent compiles trace_batch
+    (their tables, cached on disk, are then the parent's for the asking: a profile's or a
+    windy sea's take seconds to build). A scene it cannot pack is left to the parent, which
+    reports why."""
     compile_part("events")
     print(EVENTS_COMPILED, flush=True)
-    compile_part("outlined")
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no one reads on
     from ..config import load_config
     from .simulation import prepare
@@ -186,16 +218,13 @@ def startup_seconds() -> float:
 
 
 def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[Path] = ()):
-    """The photon loop, ready to call with trace_batch's arguments but the last (the table of
-    outlined functions' addresses, kernel/outline.py, which it adds): trace_batch's compiled
-    entry point (plain trace_batch under NUMBA_DISABLE_JIT=1). On a cold start the compiling
-    child also packs scene_files (child_main), and this returns once it has, so that their
-    packing here finds their tables in the disk caches."""
+    """trace_batch's compiled entry point (plain trace_batch under NUMBA_DISABLE_JIT=1). On a
+    cold start the compiling child also packs scene_files (child_main), and this returns once
+    it has, so that their packing here finds their tables in the disk caches."""
     if not hasattr(trace_batch, "overloads"):
-        calls = outline.addresses()
-        return lambda *args: trace_batch(*args, calls)
+        return trace_batch
     entry_sig = parts()["entry"][0][1]
-    if any(sig not in f.overloads for name in ("entry", "outlined") for f, sig in parts()[name]):
+    if any(sig not in f.overloads for f, sig in parts()["entry"]):
         failure = []
         child = None
 
@@ -208,12 +237,11 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
                         compile_part("collision")   # while the child compiles the other events
                         _events_compiled(child)
                 compile_part("entry")
-                if child is not None:   # the outlined functions it compiles, its packing
+                if child is not None:   # its packing of the scenes
                     try:
                         child.wait(timeout=CHILD_TIMEOUT_S)
                     except subprocess.TimeoutExpired:   # the packing here does it instead
                         child.kill()
-                compile_part("outlined")   # from the cache, where the child compiled them
             except BaseException as exc:  # handed to the main thread
                 failure.append(exc)
 
@@ -247,6 +275,4 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
         if said:
             print(f"oceanmc: photon loop compiled in {time.perf_counter() - t0:.1f} s",
                   file=sys.stderr, flush=True)
-    calls = outline.addresses()
-    entry = trace_batch.overloads[entry_sig].entry_point
-    return lambda *args: entry(*args, calls)
+    return trace_batch.overloads[entry_sig].entry_point

@@ -1,6 +1,6 @@
 """A collision's channels: the elastic one turns the packet; each inelastic one (Raman
 scattering, fluorescence) takes its share of every wavelength and emits a packet of its own."""
-from ..compile import internal, outlined
+from ..compile import internal
 from . import elastic, inelastic
 
 
@@ -13,7 +13,7 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
                            carrying, rng)
 
 
-@outlined
+@internal
 def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack, stack_ps,
          n_stacked, p, ps, layer, carrying, rng_emitted):
     """Every inelastic channel (1 .. n_channels - 1; their models: MEDIUM channel_model, all
@@ -21,6 +21,8 @@ def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
     work[:n_wl] holds the collision's weight per unit coefficient at every wavelength
     (spectral.collision_density). carrying: the packet carries the emissions on (carry), else
     each starts a packet of its own. Returns the new stack height."""
+    if medium.n_channels == 1:
+        return n_stacked
     for channel in range(1, medium.n_channels):
         n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
                                    tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,
