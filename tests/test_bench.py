@@ -4,6 +4,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from conftest import REPO
 
 
@@ -121,6 +123,24 @@ def test_spectral_section_splits_the_worst_band_into_time_and_variance():
     assert "crossing" not in text.split("|---")[-1]   # a quantity the run did not measure
     assert "| water-leaving fraction | 10.0 (420 nm) | 4.0 x 2.50 | 11.0 | 15.0 | yes | " \
         "10.0 / 80 | 8.0 x 2.50 = 20.0 |" in text
+
+
+def test_spectral_section_pools_rounds():
+    """Rounds of the spectral section: each band's relative error is the root of the rounds'
+    mean square (the mean of their variances), and the report says how many rounds and how
+    uncertain each band's FOM ratio then is (sqrt(4 / (rounds (batches - 1))): 18% for one
+    round of 128 batches, 10% for three)."""
+    from oceanmc.bench import spectral
+
+    assert spectral.pooled([[0.01, 0.03], [0.02, 0.04], [0.02, 0.00]]) == pytest.approx(
+        [0.01732051, 0.02886751])
+    assert spectral.ratio_uncertainty(1) == pytest.approx(0.1775, abs=1e-4)
+    assert spectral.ratio_uncertainty(3) == pytest.approx(0.1025, abs=1e-4)
+    data = {"spectral_photons": 1000, "single_photons": 500, "threads": 2, "rounds": 3,
+            "scenes": []}
+    text = "\n".join(spectral.report_lines(data))
+    assert "128 batches each, 3 rounds of both, interleaved" in text
+    assert "uncertain by about 10% per band" in text and "3 x 128 batches" in text
 
 
 def test_speed_section_alone_writes_speed_report(tmp_path):

@@ -6,9 +6,25 @@ figure of merit FOM = 1 / (rel_err^2 time) of each way of getting the whole spec
 run's time, or the sum of the 31 runs' times (what the spectrum costs either way), with the
 relative standard error of that band's Rrs at nadir (each run with its defaults: the nadir
 cap's local estimate, config/scene.py nadir_local, with auto's upward bias in the one-history
-run; the crossing estimate of the same cap beside it) and of its water-leaving fraction. Writes
+run; the crossing estimate of the same cap beside it) and of its water-leaving fraction. Each
+scene runs ROUNDS times both ways, interleaved (issue 26: medians of interleaved runs): the
+times are the medians, and each band's variance the mean of the rounds' (each round's batch
+variance from BATCHES batches, so the pooled one rests on ROUNDS x BATCHES). Writes
 DIR/spectral.md and DIR/spectral.json (`oceanmc bench --spectral`), and the full benchmark
-includes the section."""
+includes the section.
+
+Tried for the water-leaving fraction's weakest bands (blue, clear water), not kept:
+- an expected-value estimate of the light leaving through the surface: after every collision
+  and bottom reflection the packet's weight at each wavelength times its own exp(-tau_j / mu)
+  along the new direction and the Fresnel transmittance, instead of the crossing (a prototype,
+  Chl 0.1 deep, 2026-11-27): agreed with the crossing within |z| < 0.8 in every band, but its
+  relative standard error was 0.0073 against 0.0064 at 400 nm in the 31-band run and 0.0051
+  against 0.0046 at 410 nm alone, at 25% more time per photon in the 31-band run: the
+  variance is in whether a photon comes back up at all, not in its last flight;
+- a larger upward bias (estimator.upward_fraction 0.2 and 0.3): identical to 0.1 bit for bit,
+  the fraction being capped by 1 - w0 of the layer's most scattering wavelength (kernel/
+  upward.py).
+(Hero probabilities weighted toward the long walks: kernel/spectral.py.)"""
 from __future__ import annotations
 
 import json
@@ -34,6 +50,10 @@ TARGET = 2.0
 # uncertain by sqrt(2 / (BATCHES - 1)) (13% with 128 batches, 25% with 32): the worst of 31
 # bands is the minimum of 31 noisy ratios, so with few batches it sits well below the true worst
 BATCHES = 128
+# rounds of both ways per scene, interleaved: the machine's timings move 10-20% between runs,
+# and the worst of 31 bands' FOM ratios is the minimum of 31 noisy ratios, biased low by their
+# noise (with one round of 128 batches each ratio is uncertain by about 18%)
+ROUNDS = 3
 
 
 def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int) -> dict:
@@ -65,59 +85,91 @@ def _relative(result, name: str, k: int | None = None) -> float:
     return float(abs(err / value)) if value != 0.0 else float("inf")
 
 
+def pooled(relative_errors: list[list[float]]) -> list[float]:
+    """Per band, the relative standard error of one run from several equal runs' (rounds x
+    bands): the root of the mean of their squares, the variances' mean, which rests on all the
+    runs' batches."""
+    return [float(e) for e in np.sqrt(np.mean(np.square(relative_errors), axis=0))]
+
+
+def ratio_uncertainty(rounds: int) -> float:
+    """The relative uncertainty of one band's FOM ratio: two variances, each the mean of
+    `rounds` batch variances of BATCHES batches (relative uncertainty sqrt(2 / (rounds (BATCHES
+    - 1))) each)."""
+    return float(np.sqrt(2.0 * 2.0 / (rounds * (BATCHES - 1))))
+
+
 def measure(quick: bool, say, threads: int = 2) -> dict:
-    """Times and relative errors of both ways for every scene (the tracing, scene packing
-    included; compilation excluded: one small run first)."""
+    """Times and relative errors of both ways for every scene, ROUNDS rounds interleaved (one
+    in quick mode): the tracing, scene packing included; compilation excluded (one small run
+    first)."""
     spectral_photons = 128_000 if quick else 1_280_000
     single_photons = 32_000 if quick else 320_000
+    rounds = 1 if quick else ROUNDS
     simulate(scene(1.0, True, 2 * BATCHES, WAVELENGTHS, 1), threads=threads)     # warm up
     simulate(scene(1.0, True, 2 * BATCHES, [550.0], 1), threads=threads)
     out = {"spectral_photons": spectral_photons, "single_photons": single_photons,
-           "threads": threads, "scenes": []}
+           "threads": threads, "rounds": rounds, "scenes": []}
     for chl in CHLOROPHYLL:
         for bottom in (False, True):
-            config = scene(chl, bottom, spectral_photons, WAVELENGTHS, 1)
-            say(f"spectral: {config['name']} ...")
-            spectral, t_spectral = _timed(config, threads)
-            wavelengths = [float(w) for w in spectral.coords["wavelength"]]
-            singles = [_timed(scene(chl, bottom, single_photons, [w], 1000 + k), threads)
-                       for k, w in enumerate(wavelengths)]
-            t_singles = sum(t for _, t in singles)
-            row = {"name": config["name"], "wavelengths": wavelengths,
+            name = scene(chl, bottom, spectral_photons, WAVELENGTHS, 1)["name"]
+            times_one, times_singles, events_one, events_singles = [], [], [], []
+            values, rel_one, rel_single = {}, {}, {}
+            for r in range(rounds):
+                say(f"spectral: {name}, round {r + 1} of {rounds} ...")
+                spectral, t_spectral = _timed(
+                    scene(chl, bottom, spectral_photons, WAVELENGTHS, 1 + r), threads)
+                wavelengths = [float(w) for w in spectral.coords["wavelength"]]
+                singles = [_timed(scene(chl, bottom, single_photons, [w], 1000 * (r + 1) + k),
+                                  threads) for k, w in enumerate(wavelengths)]
+                times_one.append(t_spectral)
+                times_singles.append(sum(t for _, t in singles))
+                events_one.append(spectral.attrs["scattering_events"] / spectral_photons)
+                events_singles.append(sum(s.attrs["scattering_events"]
+                                          for s, _ in singles) / single_photons)
+                for q, _ in QUANTITIES:
+                    if q not in spectral:
+                        continue
+                    values.setdefault(q, []).append(spectral[q].tolist())
+                    rel_one.setdefault(q, []).append(
+                        [_relative(spectral, q, k) for k in range(len(wavelengths))])
+                    rel_single.setdefault(q, []).append([_relative(s, q) for s, _ in singles])
+            t_spectral, t_singles = float(np.median(times_one)), float(np.median(times_singles))
+            row = {"name": name, "wavelengths": wavelengths,
                    "time_one_history_s": t_spectral, "time_31_runs_s": t_singles,
-                   "events_one_history": spectral.attrs["scattering_events"] / spectral_photons,
-                   "events_31_runs": sum(r.attrs["scattering_events"]
-                                         for r, _ in singles) / single_photons}
-            for name, _ in QUANTITIES:
-                if name not in spectral:
-                    continue
-                rel_one = [_relative(spectral, name, k) for k in range(len(wavelengths))]
-                rel_single = [_relative(r, name) for r, _ in singles]
+                   "times_one_history_s": times_one, "times_31_runs_s": times_singles,
+                   "events_one_history": float(np.mean(events_one)),
+                   "events_31_runs": float(np.mean(events_singles))}
+            for q in values:
+                one, single = pooled(rel_one[q]), pooled(rel_single[q])
                 # a band no photon reached has rel_err inf, FOM 0
-                fom_one = [1.0 / (e * e * t_spectral) for e in rel_one]
-                fom_single = [1.0 / (e * e * t_singles) for e in rel_single]
-                row[name] = {"value": spectral[name].tolist(), "rel_err_one_history": rel_one,
-                             "rel_err_single": rel_single, "fom_one_history": fom_one,
-                             "fom_single": fom_single,
-                             "fom_ratio": [a / b if b > 0.0 else float("inf")
-                                           for a, b in zip(fom_one, fom_single)]}
+                fom_one = [1.0 / (e * e * t_spectral) for e in one]
+                fom_single = [1.0 / (e * e * t_singles) for e in single]
+                row[q] = {"value": np.mean(values[q], axis=0).tolist(),
+                          "rel_err_one_history": one, "rel_err_single": single,
+                          "fom_one_history": fom_one, "fom_single": fom_single,
+                          "fom_ratio": [a / b if b > 0.0 else float("inf")
+                                        for a, b in zip(fom_one, fom_single)]}
             out["scenes"].append(row)
     return out
 
 
 def report_lines(data: dict) -> list[str]:
+    rounds = data.get("rounds", 1)
     lines = ["## All wavelengths in one photon history (31-band Rrs spectrum)", "",
              f"Case-1 water (pure water + chlorophyll constituents), sun at 30 deg, 20% sky, "
              f"400-700 nm every 10 nm. One run of {data['spectral_photons']:,} photons with all "
              f"31 wavelengths in one history (hero wavelength + spectral MIS, kernel/spectral.py) "
              f"against 31 independent runs of {data['single_photons']:,} photons, "
-             f"{data['threads']} threads, {BATCHES} batches each. FOM = 1 / (rel_err^2 time) per "
-             "band, time = what the whole spectrum costs (the one run; the sum of the 31). "
-             "rel_err: the batch standard error over the value (each run with its defaults: "
+             f"{data['threads']} threads, {BATCHES} batches each, {rounds} round"
+             f"{'s of both, interleaved' if rounds > 1 else ''}. FOM = 1 / (rel_err^2 time) per "
+             "band, time = what the whole spectrum costs (the one run; the sum of the 31), the "
+             "median of the rounds. rel_err: the batch standard error over the value, the root "
+             "of the rounds' mean square (each run with its defaults: "
              "Rrs at nadir by the cap's local estimate, with scattering biased toward straight "
              "up in the one-history run; the FOM ratio itself is uncertain by "
-             f"about 18% per band, from "
-             f"the standard errors of {BATCHES} batches). "
+             f"about {100 * ratio_uncertainty(rounds):.0f}% per band, from "
+             f"the standard errors of {rounds} x {BATCHES} batches). "
              f"Target: FOM ratio >= {TARGET:g} in every band. The FOM ratio is the product of "
              "two factors, given for the worst band: the time ratio (the 31 runs' total time over "
              "the photons of one of them, i.e. the cost of one photon at every band, over the "
