@@ -14,7 +14,22 @@ CDOM at 500 nm), and each one's time to 1% (t (rel / 0.01)^2). The
 comparison the issue asks for: one history carrying both (the run with inelastic light gives
 the elastic and the inelastic parts at once) against the elastic run plus a separate run for
 the inelastic parts (whose time adds the elastic run's). Writes DIR/inelastic.md and
-DIR/inelastic.json (`oceanmc bench --inelastic`)."""
+DIR/inelastic.json (`oceanmc bench --inelastic`).
+
+Tried against the Raman target (its part of Rrs(550) to 1% in at most twice the elastic run's
+time; 3.5-3.6x at kernel c484c1c), prototypes measured on this section's scene (2 x 10^5
+photons, 3 interleaved rounds, 2026-11-27), not kept:
+- the emissions made at a random fraction q of the collisions, each then weighing 1 / q (the
+  draw from the emissions' stream): the run's time fell to 2.38x, 1.81x and 1.56x the elastic
+  run's at q = 0.5, 0.25 and 0.125 (3.22x at q = 1), but the Raman part's relative error grew
+  as 1 / sqrt(q) (0.34%, 0.46%, 0.66%, 0.99%), so its time to 1% against the elastic run went
+  from 3.5x to 4.9x, 7.6x and 14.6x: the Raman light's variance is in where the emissions
+  happen, and every collision's emission is worth its cost;
+- the unscattered sun's emissions scored at entry by one point drawn along the beam (a mixture
+  of three exponentials in path length), in place of the estimate at each sun packet's first
+  collision: the Raman part of Rrs(550) moved by 0.1% and its error not at all (0.34%): the
+  hero wavelengths' short free paths (red heroes collide within metres) already sample the
+  beam's emission near the surface; the variance is the scattered light's."""
 from __future__ import annotations
 
 import time

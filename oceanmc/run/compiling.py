@@ -62,6 +62,17 @@ streams. Run time every run against 5 s once: not kept. (Numba's own inlining, i
 instead of LLVM's: 151 s for one process against 48.5 s.)
 (trace_batch at LLVM level 0, its callees at 1: 7.6 s instead of 11.2 s, but its machine code
 then keeps dynamic globals, which Numba will not cache: every run would compile again.)
+Where the time goes (LLVM's pass timings, every part compiled in one process, 41.8 s, kernel
+c484c1c, 2026-11-27): trace_batch's own module, after both halves, takes 1.0 s of the cheap
+(inlining) passes, 9.05 s of full optimisation (LICM 1.1 s, InstCombine 0.9 s, about half of
+it in the analyses between passes) and 5.7 s of machine code: 14.7 s that no second process
+can share. The 181 callees' own LLVM work is 15 s of optimisation and 6.9 s of machine code,
+which is never run (only their IR is linked into trace_batch), but Numba finalises every
+function it compiles. Machine code at the target machine's level 1 instead of 3 (NUMBA_OPT=1
+before Numba's code generator starts) took as long (5.6 s). So with one merged trace_batch a
+cold start cannot fall below 14.7 s plus the longer half and Python's start-up: the 15 s of
+issue 26 needs trace_batch split (the calls by address above cost run time) or smaller (a
+trace_batch per feature set, compiled when a scene first needs it).
 """
 from __future__ import annotations
 
