@@ -37,9 +37,11 @@ user's own numba-* folders. Numba reads its CACHE_DIR when a function is decorat
 the decorators here set it for the kernel's functions alone and restore it afterwards.
 
 With NUMBA_DISABLE_JIT=1 all of these are plain Python functions."""
+import getpass
 import hashlib
 import os
 import shutil
+import tempfile
 from pathlib import Path
 
 import numba
@@ -54,17 +56,43 @@ def _kernel_hash() -> str:
     return digest.hexdigest()[:16]
 
 
-CACHE_DIR = Path(os.environ.get("OCEANMC_CACHE_DIR") or Path(__file__).parent / "__pycache__") \
-    / f"numba-{_kernel_hash()}"
 CACHE_MARKER = ".oceanmc-kernel-cache"
-for _stale in CACHE_DIR.parent.glob("numba-*"):
-    if _stale != CACHE_DIR and (_stale / CACHE_MARKER).is_file():
-        shutil.rmtree(_stale, ignore_errors=True)  # caches of earlier kernel sources
-try:
-    CACHE_DIR.mkdir(parents=True, exist_ok=True)
-    (CACHE_DIR / CACHE_MARKER).touch()
-except OSError:
-    pass  # a read-only location: Numba then compiles without its cache, as before
+
+
+def _cache_folder() -> tuple[Path, bool]:
+    """The compile cache's folder and whether it can be written: the first of
+    OCEANMC_CACHE_DIR, the package's __pycache__, the user's cache folder (XDG_CACHE_HOME or
+    ~/.cache, /oceanmc) and the temporary folder (oceanmc-<user>) where the folder can be made
+    and written. An install the user cannot write (a shared site-packages) thus caches in the
+    user's own folder; where nothing can be written, Numba compiles without a cache (every
+    process compiles again) rather than failing (measured: Numba's cache=True raises at
+    decoration when no folder of its own is writable)."""
+    roots = [Path(os.environ["OCEANMC_CACHE_DIR"])] if os.environ.get("OCEANMC_CACHE_DIR") else []
+    roots.append(Path(__file__).parent / "__pycache__")
+    try:
+        roots.append(Path(os.environ.get("XDG_CACHE_HOME") or Path("~/.cache").expanduser())
+                     / "oceanmc")
+    except RuntimeError:   # no home folder
+        pass
+    user = str(os.getuid()) if hasattr(os, "getuid") else getpass.getuser()
+    roots.append(Path(tempfile.gettempdir()) / f"oceanmc-{user}")
+    name = f"numba-{_kernel_hash()}"
+    for root in roots:
+        try:
+            (root / name).mkdir(parents=True, exist_ok=True)
+            (root / name / CACHE_MARKER).touch()
+        except OSError:
+            continue
+        if os.access(root / name, os.W_OK):
+            return root / name, True
+    return roots[0] / name, False
+
+
+CACHE_DIR, CACHE_WRITABLE = _cache_folder()
+if CACHE_WRITABLE:
+    for _stale in CACHE_DIR.parent.glob("numba-*"):
+        if _stale != CACHE_DIR and (_stale / CACHE_MARKER).is_file():
+            shutil.rmtree(_stale, ignore_errors=True)  # caches of earlier kernel sources
 
 
 def _jit(**options):
@@ -72,7 +100,7 @@ def _jit(**options):
         previous = numba.config.CACHE_DIR
         numba.config.CACHE_DIR = str(CACHE_DIR)
         try:
-            return numba.njit(error_model="numpy", cache=True, **options)(function)
+            return numba.njit(error_model="numpy", cache=CACHE_WRITABLE, **options)(function)
         finally:
             numba.config.CACHE_DIR = previous
     return decorate

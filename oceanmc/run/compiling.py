@@ -90,7 +90,7 @@ import numpy as np
 from numba.core.config import _OptLevel
 
 from ..kernel import records, sources, spectral, transport
-from ..kernel.compile import CACHE_DIR
+from ..kernel.compile import CACHE_DIR, CACHE_WRITABLE
 from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
 from ..kernel.transport import trace_batch
@@ -195,7 +195,7 @@ def child_main(scene_files: list[str]) -> None:
 
 def _start_child(scene_files: Sequence[Path]) -> subprocess.Popen | None:
     """The compiling child process (child_main), if this machine has a core to spare for it."""
-    if (os.cpu_count() or 1) < 2:
+    if (os.cpu_count() or 1) < 2 or not CACHE_WRITABLE:   # (they meet in the disk cache)
         return None
     code = "import sys; from oceanmc.run.compiling import child_main; child_main(sys.argv[1:])"
     try:
