@@ -7,6 +7,7 @@ config, a path, an option), 130 interrupted.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import shutil
 import signal
@@ -36,15 +37,17 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
     return [target / f"{c.stem}.h5" for c in configs]
 
 
-def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0) -> None:
-    """Fails before any photon is traced if the results file cannot be written."""
+def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0,
+                    resumable: bool = True) -> None:
+    """Fails before any photon is traced if the results file cannot be written (resumable:
+    the command has --resume, which the message then names)."""
     if "\0" in str(path):   # no file system takes one; Path.exists() just says False
         raise UsageError(f"{str(path)!r}: a file name cannot hold a NUL byte")
     if path.exists() and path.is_dir():
         raise UsageError(f"{path} is a folder, not a results file")
     if path.exists() and not overwrite:
-        raise UsageError(f"{path} exists; pass --overwrite to replace it (or --resume to "
-                         "continue a partial run)")
+        raise UsageError(f"{path} exists; pass --overwrite to replace it"
+                         + (" (or --resume to continue a partial run)" if resumable else ""))
     folder = path.parent if str(path.parent) else Path(".")
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -198,6 +201,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_merge(args: argparse.Namespace) -> int:
+    from .config.loading import file_problem
     from .run.hdf5 import load_result
     from .run.merge import MergeError, merge_results
     from .run.summary import format_summary
@@ -206,13 +210,14 @@ def cmd_merge(args: argparse.Namespace) -> int:
     parts = []
     for name in args.files:
         path = Path(name)
-        if not path.is_file():
-            raise UsageError(f"{path}: no such file")
+        problem = file_problem(path)
+        if problem:
+            raise UsageError(f"{path}: {problem}")
         try:
             parts.append(load_result(path))
         except ValueError as exc:  # ResultsFileError: one line saying what is wrong
             raise UsageError(f"{path}: {exc}") from None
-    _check_writable(out, args.overwrite)
+    _check_writable(out, args.overwrite, resumable=False)
     try:
         merged = merge_results(parts)
     except MergeError as exc:
@@ -224,13 +229,15 @@ def cmd_merge(args: argparse.Namespace) -> int:
 
 
 def cmd_show(args: argparse.Namespace) -> int:
+    from .config.loading import file_problem
     from .run.derived import format_derived
     from .run.hdf5 import load_result
     from .run.summary import format_summary
 
     path = Path(args.file)
-    if not path.is_file():
-        raise UsageError(f"{path}: no such file")
+    problem = file_problem(path)
+    if problem:
+        raise UsageError(f"{path}: {problem}")
     try:
         result = load_result(path)
     except ValueError as exc:  # ResultsFileError: one line saying what is wrong
@@ -260,6 +267,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from .config.loading import file_problem
     from .run.compiling import CompileInterrupted
     from .sweeps import OutputExists, SweepError, sweep
@@ -308,10 +317,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     print(f"{a['points_done']} of {a['points']} points done, {a['points_failed']} failed; "
           f"wrote {out} (finished points are kept in {out.with_suffix('.points')}/)")
     failed = lut["status"].values == "failed"
-    for index in zip(*failed.nonzero()):
+    for at in np.argwhere(failed):   # (a sweep with no axes is one point: 0-d arrays)
+        index = tuple(at)
         where = ", ".join(f"{dim} = {lut[dim].values[i]}" for dim, i in zip(lut.attrs["axes"]
                                                                         .split(","), index))
-        print(f"  failed ({where}): {lut['error'].values[index]}")
+        print(f"  failed{f' ({where})' if where else ''}: {lut['error'].values[index]}")
     return 1 if a["points_failed"] else 0
 
 
@@ -395,7 +405,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     run.add_argument("--resume", action="store_true",
                      help="continue the partial results file at the output path")
-    run.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+    run.add_argument("--checkpoint-every", type=_positive_seconds, default=60.0,
+                     metavar="SECONDS",
                      help="write the batches done so far this often (default 60 s)")
     run.set_defaults(func=cmd_run)
 
@@ -498,6 +509,16 @@ def _positive_int(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value <= 0.0:
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
     return value
 
 

@@ -113,6 +113,28 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
     assert "Traceback" not in message
 
 
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s.update(estimator={"upward_fraction": "autoo"}),
+     "config: estimator.upward_fraction = 'autoo': allowed: a valid number or 'auto'"),
+    (lambda s: s.update(estimator={"upward_fraction": -0.1}),
+     "config: estimator.upward_fraction = -0.1: allowed: a number greater than 0 or 'auto'"),
+    (lambda s: s["tallies"].update(theta_edges_deg="hydrolite"),
+     "config: tallies.theta_edges_deg = 'hydrolite': allowed: 'hydrolight' or a valid list"),
+    (lambda s: s["bottom"].update(reflectance={"fil": "sand.csv"}),
+     "config: bottom.reflectance.fil: unknown key; did you mean file? (and 1 more problem)"),
+    (lambda s: s["illumination"].update(sky={"mapp": "sky.csv"}),
+     "config: illumination.sky.mapp: unknown key; did you mean map? (and 1 more problem)"),
+])
+def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
+        small_scene, change, message):
+    """A key that takes one of several kinds (a number or 'auto'; a list or 'hydrolight'; a
+    value or a table file) gets one pydantic error per kind: one line says what each allows,
+    under the key as the user wrote it (no 'constrained-float'); a misspelt key of a mapping
+    is named before the keys it leaves missing."""
+    change(small_scene)
+    assert _error(small_scene) == message
+
+
 def test_bottom_none_needs_an_infinitely_deep_layer(small_scene):
     small_scene["bottom"] = {"model": "none"}
     assert "infinitely deep" in _error(small_scene)

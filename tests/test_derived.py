@@ -86,6 +86,25 @@ def test_standard_errors_match_the_spread_of_repeated_runs():
     assert 0.75 < np.median(every) < 1.33, np.median(every)
 
 
+def test_a_zero_irradiance_leaves_a_quantity_undefined_not_infinite():
+    """Eu = 0 at a black bottom: Ku down to it (ln(Eu / 0)) and Q, mu_u there (0 / 0) are NaN
+    with NaN errors, not inf; R there is 0; the summary says 'undefined' and why, and prints
+    no inf or nan."""
+    config = scene(photons=16 * 500)
+    config["bottom"] = {"model": "black"}
+    config["tallies"]["depths_m"] = [0.0, 8.0]
+    result = oceanmc.simulate(config, threads=2)
+    derived = derive(result)
+    for name in ("Ku", "Q", "mu_u"):
+        assert np.isnan(derived[name].value[-1]) and np.isnan(derived[name].stderr[-1]), name
+        assert "NaN where undefined" in derived[name].description
+    assert np.isfinite(derived["Kd"].value).all() and derived["R"].value[-1] == 0.0
+    text = format_derived(result)
+    assert "Ku(0-..8 m)                 m-1          undefined   (a zero Eu)" in text, text
+    assert "Q(8 m)" in text and "(a zero Eu or Lu)" in text
+    assert "inf" not in text and " nan" not in text
+
+
 def test_the_file_holds_them_and_show_prints_them(tmp_path, capsys):
     result = oceanmc.simulate(scene(photons=16 * 500), threads=2)
     path = result.save(tmp_path / "r.h5")

@@ -3,6 +3,7 @@ wrong answer, a lost run or someone else's files deleted."""
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -25,6 +26,42 @@ def test_cache_dir_keeps_folders_oceanmc_did_not_create(tmp_path):
     assert not ours.exists()
     current = [p for p in tmp_path.glob("numba-*") if p != users]
     assert len(current) == 1 and (current[0] / ".oceanmc-kernel-cache").is_file()
+
+
+def test_an_unwritable_cache_folder_falls_back_to_a_writable_one(tmp_path):
+    """OCEANMC_CACHE_DIR (or an installed package's __pycache__) that cannot be made or
+    written: the compile cache goes to the next writable folder instead of Numba failing at
+    import with a traceback (a folder under a regular file cannot be made, even by root)."""
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    env = dict(ENV, OCEANMC_CACHE_DIR=str(blocker / "cache"))
+    done = subprocess.run([sys.executable, "-c", "from oceanmc.kernel.compile import CACHE_DIR, "
+                           "CACHE_WRITABLE; print(CACHE_DIR); print(CACHE_WRITABLE)"],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    folder, writable = done.stdout.split()
+    assert writable == "True" and not folder.startswith(str(blocker))
+    assert (Path(folder) / ".oceanmc-kernel-cache").is_file()
+
+
+@pytest.mark.parametrize("value", ["nan", "-1", "0", "inf", "soon"])
+def test_checkpoint_interval_must_be_a_positive_finite_number(tmp_path, value):
+    """--checkpoint-every nan would never checkpoint (every comparison with NaN is false), a
+    negative one would rewrite the file at every poll: refused in one line, exit 2."""
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "run", "scene.yaml",
+                           "--checkpoint-every", value], cwd=tmp_path, env=ENV,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert f"--checkpoint-every: expected a finite number of seconds > 0, got '{value}'" \
+        in done.stderr and "Traceback" not in done.stderr
+
+
+def test_show_and_plot_say_a_folder_is_not_a_results_file(tmp_path):
+    for command in ("show", "plot"):
+        done = subprocess.run([sys.executable, "-m", "oceanmc", command, str(tmp_path)],
+                              env=ENV, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 2 and done.stderr.strip().endswith(
+            f"{tmp_path}: not a regular file"), done.stderr
 
 
 # --- configs: read safely, one line per problem -------------------------------------------

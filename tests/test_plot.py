@@ -234,6 +234,20 @@ def test_file_without_radiance_draws_the_rest(mono_file, tmp_path, capsys):
                                                              "bare_rrs.png"]
 
 
+def test_a_run_without_tally_depths_draws_its_rrs_and_says_why_not_the_rest(tmp_path,
+                                                                               capsys):
+    """tallies.depths_m: [] leaves nothing to draw in the water: the Rrs figure alone, and a
+    note for each other figure naming the key (no IndexError)."""
+    import oceanmc
+    config = dict(SMALL_SCENE, photons=2000, tallies={"depths_m": []})
+    path = oceanmc.simulate(oceanmc.load_config(config), threads=1).save(tmp_path / "air.h5")
+    assert main(["plot", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert "has no Ed at any depth (tallies.depths_m: []); no profiles figure" in err
+    assert "has no radiance in the water" in err and "tallies.depths_m: []" in err
+    assert [p.name for p in tmp_path.glob("*.png")] == ["air_rrs.png"]
+
+
 def _copy(source, target):
     target.write_bytes(source.read_bytes())
     return target

@@ -189,6 +189,42 @@ def test_every_point_is_validated_first_with_its_coordinates_one_line_exit_2(tmp
         build_points(load_sweep(sweep_file(tmp_path, {"tallies.depths_m": [[0], [0, 1]]})))
 
 
+def test_repeated_axis_values_and_too_many_batch_groups_are_refused_before_any_run(tmp_path):
+    """A value given twice on an axis (the dataset's coordinate would hold it twice, and
+    selecting it return two points), and batch_groups beyond what a point's batches allow
+    (each group runs as a scene of 2 batches or more): one line naming the key, before
+    anything is compiled or run."""
+    with pytest.raises(SweepError, match=r"^axes: bottom\.reflectance: point 3 repeats point 1 "
+                       r"\(0\.1\); allowed: distinct values$"):
+        load_sweep(sweep_file(tmp_path, {"bottom.reflectance": [0.1, 0.2, 0.1]}))
+    with pytest.raises(SweepError, match=r"axes: bottom\.reflectance and bottom\.model: point 2"):
+        load_sweep(sweep_file(tmp_path, {"zip": {"bottom.reflectance": [0.1, 0.1],
+                                                 "bottom.model": ["lambertian"] * 2}}))
+    # the same reflectance with another model is another point
+    load_sweep(sweep_file(tmp_path, {"zip": {"bottom.reflectance": [0.1, 0.1],
+                                             "bottom.model": ["lambertian", "minnaert"]}}))
+    path = sweep_file(tmp_path, {"bottom.reflectance": [0.1]}, batch_groups=4)   # 4 batches
+    with pytest.raises(SweepError, match=r"^batch_groups = 4: point \(bottom\.reflectance = "
+                       r"0\.1\) has 4 batches, which can be spread over at most 2 groups .*"
+                       r"allowed: 1 \.\. 2, or give the scene more batches$"):
+        oceanmc.sweeps.prepare(path, tmp_path / "lut.points")
+    assert not (tmp_path / "lut.points").exists()
+
+
+def test_a_sweep_without_axes_is_one_point_and_exits_0(tmp_path):
+    """The README's sweep with no axes (one scene spread over batch groups): the dataset is
+    written and the command exits 0 (it crashed on the 0-d status array after writing it)."""
+    path = tmp_path / "one.yaml"
+    path.write_text(yaml.safe_dump({"base": TINY, "batch_groups": 2}, sort_keys=False))
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", path, "-o", "one.nc",
+                           "--workers", "1", "--threads", "1"], cwd=tmp_path, env=ENV,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "1 of 1 points done, 0 failed" in done.stdout and "Traceback" not in done.stderr
+    with xr.open_dataset(tmp_path / "one.nc", engine="h5netcdf") as ds:
+        assert ds["status"].values[()] == "done"
+
+
 # --- a LocalCluster of two worker processes ---------------------------------------------------
 
 def test_local_cluster_two_processes_points_bit_identical_batch_groups_and_rerun(tmp_path):

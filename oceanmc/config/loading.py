@@ -182,12 +182,25 @@ def _parse_yaml(text: str, origin: str, kind: str = "scene") -> Any:
         raise ConfigError(f"{origin}: nested too deeply to be a {kind}") from None
 
 
+# pydantic's names for the members of a union that are not models (a number with bounds, a
+# literal, a list, ...), in an error's location after the field's key
+_BRANCH_TAG_PREFIXES = ("list[", "literal[", "dict[", "tuple[", "function-", "constrained-")
+_BRANCH_TAG_NAMES = frozenset({"float", "int", "str", "bool", "none"})
+
+
+def _is_branch_tag(part: Any) -> bool:
+    """Whether a part of an error's location names a union's member, not a key the user
+    wrote."""
+    return isinstance(part, str) and (part in _UNION_TAGS or part in _BRANCH_TAG_NAMES
+                                      or part.startswith(_BRANCH_TAG_PREFIXES))
+
+
 def _key_path(loc: tuple) -> str:
     path = ""
     for part in loc:
         if isinstance(part, int):
             path += f"[{part}]"
-        elif part in _UNION_TAGS or str(part).startswith(("list[", "literal[")):
+        elif _is_branch_tag(part):
             continue  # pydantic's union-branch tags are not keys the user wrote
         else:
             # a key with a line break or another unprintable character is shown quoted, so
@@ -258,6 +271,43 @@ def _describe(error: dict) -> str:
     return f"{path}: {msg}"
 
 
+def _first_problem(errors: list[dict]) -> tuple[str, int]:
+    """The message for pydantic's first error, and how many errors it covers. A value that
+    fits no member of a union (upward_fraction: a number in (0, 1), 'auto' or null) gets one
+    error per member at the same key: one line with what each member allows. An unknown key
+    beside missing ones in the same mapping (a misspelt key) is named first, with the nearest
+    valid key."""
+    def parent(error: dict) -> str:
+        return _key_path(tuple(error.get("loc", ()))[:-1])
+
+    first = errors[0]
+    if first.get("type") == "missing":
+        for error in errors:
+            if error.get("type") == "extra_forbidden" and parent(error) == parent(first):
+                return _describe(error), 1
+    loc = tuple(first.get("loc", ()))
+    # (a member that is a model reports its own keys after the tag: described as they are)
+    if not (loc and _is_branch_tag(loc[-1])) or isinstance(first.get("input"), dict):
+        return _describe(first), 1
+    path = _key_path(loc)
+    members = [e for e in errors if _key_path(tuple(e.get("loc", ()))) == path]
+    if len(members) == 1:
+        return _describe(first), 1
+    allowed: list[str] = []
+    for error in members:
+        text = error.get("msg", "").split(", unable")[0]
+        text = text[len("Input should be "):] if text.startswith("Input should be ") else text
+        if error.get("type") in ("greater_than", "greater_than_equal", "less_than",
+                                 "less_than_equal"):
+            text = "a number " + text
+        if text not in allowed:
+            allowed.append(text)
+    shown = repr(first["input"]) if "input" in first else "this value"
+    if len(shown) > 80:
+        shown = shown[:77] + "..."
+    return f"{path} = {shown}: allowed: {' or '.join(allowed)}", len(members)
+
+
 def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] | None = None,
                 *, base_dir: str | Path | None = None) -> SceneConfig:
     """Reads a scene from a YAML file path or a dict, applies top-level overrides (photons, seed),
@@ -289,14 +339,14 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
         config = SceneConfig.model_validate(data)
     except ValidationError as exc:
         errors = exc.errors()
-        first = _describe(errors[0])
+        first, shown = _first_problem(errors)
         blamed = [key for key, value in (overrides or {}).items()
                   if value is not None and (first.startswith(f"{key} ")
                                             or first.startswith(f"{key}:"))]
         if blamed:  # the value came from the command line, not from the file
             origin = f"--{blamed[0]} (with {origin})"
-        more = f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})" \
-            if len(errors) > 1 else ""
+        rest = len(errors) - shown
+        more = f" (and {rest} more problem{'s' if rest > 1 else ''})" if rest else ""
         raise ConfigError(f"{origin}: {first}{more}") from None
     except RecursionError:
         raise ConfigError(f"{origin}: nested too deeply to be a scene") from None

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..config.loading import file_problem
 from ..run.results import PART_LABELS, lowest_requested
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
@@ -58,8 +59,9 @@ class ResultFile:
 def open_result(path: str | Path) -> ResultFile:
     import xarray as xr
     path = Path(path)
-    if not path.is_file():
-        raise PlotInputError(f"{path}: no such file")
+    problem = file_problem(path)
+    if problem:
+        raise PlotInputError(f"{path}: {problem}")
     try:
         water = xr.load_dataset(path, engine="h5netcdf", phony_dims="access")
     except (OSError, ValueError) as exc:
@@ -345,7 +347,8 @@ def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
 
 
 # the quantity each figure needs, for the note when a file lacks it
-NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed", "radiance": "radiance (tallies.radiance: false)",
+NEEDS = {"rrs": "air/Rrs_nadir", "profiles": "Ed at any depth (tallies.depths_m: [])",
+         "radiance": "radiance in the water (tallies.radiance: false, or tallies.depths_m: [])",
          "kd_r": "derived/Kd and derived/R (group derived: written by an oceanmc that derives "
                  "them, from at least two tally depths)"}
 # at most this many depths (and intervals) get a line in the Kd and R panels, evenly spaced
@@ -359,15 +362,17 @@ def _drawn_values(result: ResultFile, indices: list[int], depth: int,
     drawn: dict[str, dict[str, np.ndarray]] = {"rrs": {}, "profiles": {}, "radiance": {}}
     if "Rrs_nadir" in result.air:
         drawn["rrs"]["air/Rrs_nadir"] = np.asarray(result.air["Rrs_nadir"])
+    # a run with tallies.depths_m: [] has no depth to draw in the water
+    has_depths = len(result.depths) > 0
     for name, _ in PROFILE_QUANTITIES:
-        if name in result.water:
+        if name in result.water and has_depths:
             drawn["profiles"][name] = np.array([np.asarray(_at(result.water[name], i))
                                                 for i in lines])
     derived = result.derived
     if result.wavelengths is not None:   # Kd(l) and R(l): spectral files only
         drawn["kd_r"] = {f"derived/{name}": np.asarray(derived[name]) for name in ("Kd", "R")
                          if derived is not None and "Kd" in derived and "R" in derived}
-    if "radiance" in result.water:
+    if "radiance" in result.water and has_depths:
         drawn["radiance"]["radiance"] = np.asarray(
             _at(result.water["radiance"], wavelength).isel(depth=depth))
         if "radiance" in result.air:

@@ -43,6 +43,7 @@ class Derived:
     stderr: np.ndarray
     units: str
     description: str
+    sources: tuple[str, ...]   # the quantities it is derived from (Eu, Ed, ...)
 
 
 def jackknife(f: Callable[..., np.ndarray], *batches: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -87,7 +88,14 @@ def derive(result) -> dict[str, Derived]:
     def add(name, these, units, description, f, *sources):
         if all(s in q for s in sources):
             value, err = jackknife(f, *(q[s].batches for s in sources))
-            out[name] = Derived(name, these, value, err, units, description)
+            # a ratio or a logarithm of a zero irradiance or radiance (say Eu at a black
+            # bottom) has no value: NaN with a NaN error, not inf
+            undefined = ~np.isfinite(value)
+            value = np.where(undefined, np.nan, value)
+            err = np.where(undefined, np.nan, err)
+            out[name] = Derived(name, these, value, err, units,
+                                description + " (NaN where undefined: a zero "
+                                + " or ".join(sources) + ")", sources)
 
     if len(depths) > 1:
         k = _attenuation(depths)
@@ -188,9 +196,12 @@ def format_derived(result) -> str:
                      f"{'rel err':>10}")
         for d in derived.values():
             for i, (value, err) in enumerate(zip(d.value, d.stderr)):
-                rel = abs(err / value) if value != 0.0 and math.isfinite(value) else math.nan
-                lines.append(f"  {label(d, i):<28}{d.units:<9}{value:>13.6g}{err:>12.3g}"
-                             f"{rel:>10.2%}")
+                if math.isnan(value):
+                    lines.append(f"  {label(d, i):<28}{d.units:<9}{'undefined':>13}   "
+                                 f"(a zero {' or '.join(d.sources)})")
+                    continue
+                rel = f"{abs(err / value):>10.2%}" if value != 0.0 else f"{'-':>10}"
+                lines.append(f"  {label(d, i):<28}{d.units:<9}{value:>13.6g}{err:>12.3g}{rel}")
         return "\n".join(lines)
     heads = [(label(d, 0), d) for d in derived.values()]
     lines.append(f"  {'nm':>6}" + "".join(f" {head:>17}" for head, _ in heads))
@@ -198,8 +209,11 @@ def format_derived(result) -> str:
         cells = []
         for _, d in heads:
             value, err = d.value[k, 0], d.stderr[k, 0]
-            rel = abs(err / value) if value != 0.0 and math.isfinite(value) else math.nan
-            cells.append(f"{value:>10.4g} {rel:>6.1%}")
+            if math.isnan(value):
+                cells.append(f"{'undefined':>17}")
+                continue
+            rel = f"{abs(err / value):>6.1%}" if value != 0.0 else f"{'-':>6}"
+            cells.append(f"{value:>10.4g} {rel}")
         lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>17}" for cell in cells))
     note = ("(value and relative standard error; K in 1/m over the first interval of tally "
             "depths, the others at the first depth; Q in sr; every depth and interval in the "

@@ -18,7 +18,7 @@ from typing import Any, Callable
 from .axes import SweepError, SweepSpec, load_sweep, set_key_path
 from .dataset import (OutputExists, PointStore, Summary, assemble, check_replaceable,
                       write_dataset)
-from .points import Point, build_points, check_scenes
+from .points import Point, build_points, check_batch_groups, check_scenes
 
 __all__ = ["sweep", "prepare", "SweepError", "OutputExists", "SweepSpec", "load_sweep",
            "set_key_path", "points_folder"]
@@ -66,6 +66,7 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
     if batch_groups is not None:
         spec = SweepSpec(spec.base, spec.base_dir, spec.settings, spec.axes, batch_groups)
     points = build_points(spec)
+    check_batch_groups(spec.batch_groups, points)
     if replacing is not None:
         check_replaceable(replacing, store_folder, spec)
     ready(should_stop)   # compiles here, once, into the disk cache that local workers load from

@@ -320,6 +320,8 @@ def _axes(spec: Any) -> tuple[Axis, ...]:
         else:
             path, alias, grid = _entry(key, values)
             axes.append(Axis((path,), (grid,), (alias,)))
+    for axis in axes:
+        _check_distinct(axis)
     seen: set[str] = set()
     for axis in axes:
         for key in axis.keys:
@@ -385,6 +387,20 @@ def _zip_axis(group: Any) -> Axis:
         raise SweepError(f"axes.zip: the lists must have equal lengths; got "
                          f"{', '.join(f'{k}: {n}' for k, n in lengths.items())}")
     return Axis(keys, values, tuple(alias for _, alias, _ in entries))
+
+
+def _check_distinct(axis: Axis) -> None:
+    """SweepError where two points of an axis are the same (a zip axis: the same values of all
+    its keys): the dataset's coordinate would hold a value twice, and selecting it would
+    return two points."""
+    columns = [coordinate(values) for values in axis.values]
+    seen: dict[tuple, int] = {}
+    for i, point in enumerate(zip(*columns)):
+        if point in seen:
+            keys = " and ".join(axis.keys)
+            raise SweepError(f"axes: {keys}: point {i + 1} repeats point {seen[point] + 1} "
+                             f"({', '.join(str(v) for v in point)}); allowed: distinct values")
+        seen[point] = i
 
 
 def _values(key: str, values: Any) -> tuple[Any, ...]:

@@ -63,6 +63,25 @@ def build_points(spec: SweepSpec) -> list[Point]:
     return points
 
 
+def most_batch_groups(point: Point) -> int:
+    """The most batch groups the point's batches can be spread over: the first group runs as
+    a scene of its end's batch count (part_yaml), which must be at least 2."""
+    return next(g for g in range(point.config.batches, 0, -1)
+                if g == 1 or point.batch_ranges(g)[0][1] >= 2)
+
+
+def check_batch_groups(groups: int, points: list[Point]) -> None:
+    """SweepError, before anything runs, where a point has too few batches for `groups`."""
+    for point in points:
+        most = most_batch_groups(point)
+        if groups > most:
+            raise SweepError(
+                f"batch_groups = {groups}: point ({point.label}) has {point.config.batches} "
+                f"batches, which can be spread over at most {most} groups (each group's scene "
+                f"needs 2 batches or more); allowed: 1 .. {most}, or give the scene more "
+                "batches")
+
+
 def check_scenes(points: list[Point]) -> None:
     """Packs every point's scene (which reads and checks its table files, BRDF checks and
     tables: ConfigError) without tracing a photon. Needs the compiled kernel (run.compiling)."""
