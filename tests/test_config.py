@@ -135,6 +135,30 @@ def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
     assert _error(small_scene) == message
 
 
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s.update(photons=True), "config: photons = True: expected a number"),
+    (lambda s: s["water"]["layers"][0].update(a=True),
+     "config: water.layers[0]: a = True: expected a number"),
+    (lambda s: s["bottom"].update(reflectance=False),
+     "config: bottom: reflectance = False: expected a number"),
+    (lambda s: s["illumination"].update(sun_zenith_deg=True),
+     "config: illumination: sun_zenith_deg = True: expected a number"),
+])
+def test_a_boolean_for_a_number_is_refused(small_scene, change, message):
+    """pydantic reads True as 1 and YAML reads yes/no/on/off as booleans: `a: yes` ran with
+    a = 1 and exit status 0. Refused in one line naming the key."""
+    change(small_scene)
+    assert _error(small_scene).startswith(message + " (YAML reads true, false, yes, no, on "
+                                          "and off as booleans)")
+
+
+def test_booleans_stay_allowed_where_they_mean_something(small_scene):
+    small_scene["tallies"]["radiance"] = False
+    small_scene["estimator"] = {"depth_splitting": True}   # YAML's `on`
+    config = load_config(small_scene)
+    assert config.tallies.radiance is False and config.estimator.depth_splitting == "on"
+
+
 def test_bottom_none_needs_an_infinitely_deep_layer(small_scene):
     small_scene["bottom"] = {"model": "none"}
     assert "infinitely deep" in _error(small_scene)

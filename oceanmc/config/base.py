@@ -1,17 +1,45 @@
 """What every part of the schema shares: the error type, the strict base model, number types."""
 from __future__ import annotations
 
-from typing import Annotated
+import types
+import typing
+from typing import Annotated, Any
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 
 class ConfigError(ValueError):
     """A scene that cannot be run; the message names the key, the value and what is allowed."""
 
 
+def _admits_boolean(annotation: Any) -> bool:
+    """Whether a field may take a boolean: a bool, Any, or a Literal (whose own validator may
+    read one, as depth_splitting reads YAML's `on`), alone or in a union, through Annotated."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _admits_boolean(typing.get_args(annotation)[0])
+    if origin in (typing.Union, types.UnionType):
+        return any(_admits_boolean(a) for a in typing.get_args(annotation))
+    return annotation in (bool, Any) or origin is typing.Literal
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_default=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_boolean_for_a_number(cls, data: Any) -> Any:
+        # pydantic takes True for 1 and False for 0, and YAML reads yes, no, on, off, true and
+        # false as booleans: `a: yes` would run with a = 1 (a boolean where a number, a list
+        # or a table is expected is refused here, naming the key)
+        if isinstance(data, dict):
+            for name, value in data.items():
+                field = cls.model_fields.get(name) if isinstance(name, str) else None
+                if isinstance(value, bool) and field is not None \
+                        and not _admits_boolean(field.annotation):
+                    raise ValueError(f"{name} = {value}: expected a number (YAML reads true, "
+                                     "false, yes, no, on and off as booleans)")
+        return data
 
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
