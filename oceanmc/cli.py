@@ -405,9 +405,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     run.add_argument("--resume", action="store_true",
                      help="continue the partial results file at the output path")
-    run.add_argument("--checkpoint-every", type=_positive_seconds, default=60.0,
-                     metavar="SECONDS",
-                     help="write the batches done so far this often (default 60 s)")
+    run.add_argument("--checkpoint-every", type=_seconds, default=60.0, metavar="SECONDS",
+                     help="write the batches done so far this often (default 60 s; 0: at "
+                          "every check, about twice a second)")
     run.set_defaults(func=cmd_run)
 
     merge = sub.add_parser("merge", help="combine independent runs of one scene (other seeds)")
@@ -512,13 +512,14 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _positive_seconds(text: str) -> float:
+def _seconds(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
         value = math.nan
-    if not math.isfinite(value) or value <= 0.0:
-        raise argparse.ArgumentTypeError(f"expected a finite number of seconds > 0, got {text!r}")
+    if not math.isfinite(value) or value < 0.0:
+        raise argparse.ArgumentTypeError(f"expected a finite number of seconds >= 0, got "
+                                         f"{text!r}")
     return value
 
 

@@ -275,15 +275,16 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
     """The message for pydantic's first error, and how many errors it covers. A value that
     fits no member of a union (upward_fraction: a number in (0, 1), 'auto' or null) gets one
     error per member at the same key: one line with what each member allows. An unknown key
-    beside missing ones in the same mapping (a misspelt key) is named first, with the nearest
-    valid key."""
+    close to a valid one, beside missing keys in the same mapping (a misspelt key), is named
+    first with the nearest valid key; else the missing key is."""
     def parent(error: dict) -> str:
         return _key_path(tuple(error.get("loc", ()))[:-1])
 
     first = errors[0]
     if first.get("type") == "missing":
         for error in errors:
-            if error.get("type") == "extra_forbidden" and parent(error) == parent(first):
+            if error.get("type") == "extra_forbidden" and parent(error) == parent(first) \
+                    and _suggestion(tuple(error.get("loc", ()))).startswith("; did you mean"):
                 return _describe(error), 1
     loc = tuple(first.get("loc", ()))
     # (a member that is a model reports its own keys after the tag: described as they are)

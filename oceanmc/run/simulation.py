@@ -316,10 +316,10 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
     tallies (a fault of oceanmc) raises NonFiniteResult, at the end or at a checkpoint."""
     if not isinstance(config, (PreparedRun, SceneConfig)):
         config = load_config(config)
-    if not (math.isfinite(checkpoint_every_s) and checkpoint_every_s > 0.0):
+    if not (math.isfinite(checkpoint_every_s) and checkpoint_every_s >= 0.0):
         # (a NaN would never checkpoint: every comparison with it is false)
         raise ValueError(f"checkpoint_every_s = {checkpoint_every_s}: allowed a finite number "
-                         "of seconds > 0")
+                         "of seconds >= 0")
     # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
     # number of cores) is the default and the most
     n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
