@@ -170,13 +170,16 @@ def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.nda
     return _COMPONENT_MOMENTS[key]
 
 
-# Below this Beckmann roughness (sqrt of the mean square slope) the rough sea's lobe K is
-# narrower than the quadrature over the air cap resolves (cap_tables.ROUGH_POLAR_NODES x
-# ROUGH_AZIMUTHS): Rrs nadir by the cap's estimate read 6% low at mean square slope 3e-5, 38% at
-# 1e-5 and 74% at 1e-6 (a Lambertian bottom at 5 m, HG 0.9; flat 0.01703 +- 0.00015). There the
-# cap tables are the flat surface's, the limit K tends to: their difference is of order the
-# roughness squared (at 1e-4, where both work: 0.01708 +- 0.00011 through the lobe)
-MIN_LOBE_ROUGHNESS = 0.01
+# The rough sea's lobe K is about (n - 1) alpha wide in the air (alpha the Beckmann roughness,
+# the root of the mean square slope; a facet tilted by alpha turns the refracted light by
+# about (n - 1) alpha). Narrower than this, the quadrature over the air cap
+# (cap_tables.ROUGH_POLAR_NODES x ROUGH_AZIMUTHS) does not resolve it: with n = 1.34, Rrs nadir
+# by the cap's estimate read 6% low at mean square slope 3e-5, 38% at 1e-5 and 74% at 1e-6 (a
+# Lambertian bottom at 5 m, HG 0.9; flat 0.01703 +- 0.00015), and n = 1 (no refraction) failed
+# with an IndexError. There the cap tables are the flat surface's, the limit K tends to: their
+# difference is of order alpha squared (at 1e-4, where both work: 0.01708 +- 0.00011 through
+# the lobe). The width at n = 1.34 and mean square slope 1e-4:
+MIN_LOBE_WIDTH = 0.34 * 0.01
 
 
 def rough_mean_cosine(enabled: bool, roughness: float, n: float, beta: float,
@@ -213,9 +216,9 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
     n_wl = len(config.wavelengths)
     # through the rough sea (isotropic slopes: config/scene.py) the air cap's light comes from
     # the in-water lobe K of kernel/rough_cap.py (cap_tables.RoughCap); a sea nearly flat
-    # takes the flat surface's tables (MIN_LOBE_ROUGHNESS)
+    # takes the flat surface's tables (MIN_LOBE_WIDTH)
     roughness = 0.0 if surface[0]["delta"] else float(surface[0]["alpha_u"])
-    if roughness < MIN_LOBE_ROUGHNESS:
+    if (n - 1.0) * roughness < MIN_LOBE_WIDTH:
         roughness = 0.0
     geometry = (beta, mu_w, beta_w, mu_a, roughness, n)
 
