@@ -65,6 +65,30 @@ def test_show_and_plot_say_a_folder_is_not_a_results_file(tmp_path):
             f"{tmp_path}: not a regular file"), done.stderr
 
 
+def test_saving_over_an_existing_file_without_overwrite_is_refused_before_writing(tmp_path):
+    """Result.save(path, overwrite=False) on a file that exists: FileExistsError naming the
+    option, the file untouched and no stray file beside it (it wrote <stem>.<pid>.h5 and blamed
+    "another process")."""
+    import oceanmc
+    from conftest import SMALL_SCENE
+    result = oceanmc.simulate(dict(SMALL_SCENE, photons=400), threads=1)
+    path = result.save(tmp_path / "r.h5")
+    before = path.read_bytes()
+    with pytest.raises(FileExistsError, match=r"r\.h5 exists; save\(\.\.\., overwrite=True\) "
+                       r"replaces it"):
+        result.save(path, overwrite=False)
+    assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
+
+
+@pytest.mark.parametrize("threads", [0, -3, "x", 1.5])
+def test_simulate_refuses_a_thread_count_that_is_not_a_positive_integer(threads):
+    """simulate(threads=0) ran on 1 thread without a word, threads='x' gave int()'s error."""
+    import oceanmc
+    from conftest import SMALL_SCENE
+    with pytest.raises(ValueError, match=rf"^threads = {threads!r}: allowed an integer >= 1"):
+        oceanmc.simulate(dict(SMALL_SCENE, photons=400), threads=threads)
+
+
 # --- configs: read safely, one line per problem -------------------------------------------
 
 import yaml  # noqa: E402

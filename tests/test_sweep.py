@@ -211,6 +211,17 @@ def test_repeated_axis_values_and_too_many_batch_groups_are_refused_before_any_r
     assert not (tmp_path / "lut.points").exists()
 
 
+@pytest.mark.parametrize("option", [{"workers": 0}, {"workers": -1}, {"threads": 0},
+                                    {"batch_groups": 0}, {"batch_groups": 1.5}])
+def test_sweep_options_of_the_python_api_are_checked_as_the_command_checks_them(tmp_path,
+                                                                                 option):
+    """oceanmc.sweep(workers=-1) started no worker and waited for ever, batch_groups=0 divided
+    by zero: each is refused in one line before anything runs."""
+    (name, value), = option.items()
+    with pytest.raises(SweepError, match=rf"^{name} = {value!r}: expected an integer >= 1$"):
+        oceanmc.sweep(sweep_file(tmp_path, {"bottom.reflectance": [0.1]}), **option)
+
+
 def test_a_sweep_without_axes_is_one_point_and_exits_0(tmp_path):
     """The README's sweep with no axes (one scene spread over batch groups): the dataset is
     written and the command exits 0 (it crashed on the 0-d status array after writing it)."""

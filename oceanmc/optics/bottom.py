@@ -91,9 +91,11 @@ def _lambertian_specular(bottom, wavelengths_nm: np.ndarray):
     rho = d + s
     if not bottom.allow_unphysical and rho.max() > 1.0:
         j = int(np.argmax(rho))
+        # (a monochromatic scene's grid is [nan]: no wavelength to name)
+        at = "" if np.isnan(wavelengths_nm[j]) else f" at {wavelengths_nm[j]:g} nm"
         raise ConfigError(
-            f"bottom.model = 'lambertian_specular': not energy conserving at "
-            f"{wavelengths_nm[j]:g} nm: diffuse_reflectance + specular_reflectance = "
+            f"bottom.model = 'lambertian_specular': not energy conserving{at}: "
+            f"diffuse_reflectance + specular_reflectance = "
             f"{d[j]:g} + {s[j]:g} = {rho[j]:g} > 1 (rho_dh at every incidence angle); set "
             "bottom.allow_unphysical: true to run it anyway")
     top_d, top_s = float(d.max()), float(s.max())

@@ -258,7 +258,8 @@ def kd_r_figure(result: ResultFile):
         ax.set_title(title, fontsize=9)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, title="depths", title_fontsize=7)
-    if np.nanmin(np.asarray(derived["Kd"])) > 0.0:
+    kd = np.asarray(derived["Kd"])
+    if np.isfinite(kd).any() and np.nanmin(kd) > 0.0:   # (all NaN: numpy would warn)
         axes[0].set_yscale("log")
     return fig
 

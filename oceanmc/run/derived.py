@@ -200,6 +200,10 @@ def format_derived(result) -> str:
                     lines.append(f"  {label(d, i):<28}{d.units:<9}{'undefined':>13}   "
                                  f"(a zero {' or '.join(d.sources)})")
                     continue
+                if math.isnan(err):   # a batch left out leaves it undefined (one lit batch)
+                    lines.append(f"  {label(d, i):<28}{d.units:<9}{value:>13.6g}"
+                                 f"{'unknown':>12}{'-':>10}")
+                    continue
                 rel = f"{abs(err / value):>10.2%}" if value != 0.0 else f"{'-':>10}"
                 lines.append(f"  {label(d, i):<28}{d.units:<9}{value:>13.6g}{err:>12.3g}{rel}")
         return "\n".join(lines)
@@ -212,7 +216,8 @@ def format_derived(result) -> str:
             if math.isnan(value):
                 cells.append(f"{'undefined':>17}")
                 continue
-            rel = f"{abs(err / value):>6.1%}" if value != 0.0 else f"{'-':>6}"
+            rel = f"{'?':>6}" if math.isnan(err) else \
+                f"{abs(err / value):>6.1%}" if value != 0.0 else f"{'-':>6}"
             cells.append(f"{value:>10.4g} {rel}")
         lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>17}" for cell in cells))
     note = ("(value and relative standard error; K in 1/m over the first interval of tally "

@@ -71,7 +71,10 @@ class Result:
 
     def save(self, path: str | Path, overwrite: bool = True) -> Path:
         """Writes the results file (format.save_result); overwrite=False: never replace an
-        existing file (placement.place_atomically)."""
+        existing file (placement.place_atomically), and refuse one that exists before writing
+        anything (FileExistsError)."""
+        if not overwrite and Path(path).exists():
+            raise FileExistsError(f"{path} exists; save(..., overwrite=True) replaces it")
         return save_result(self, path, overwrite)
 
 

@@ -11,6 +11,7 @@ Result.resume_state, from which a resumed run continues them exactly."""
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import sys
 import threading
@@ -322,8 +323,12 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
                          "of seconds >= 0")
     # batches run in threads (trace_batch releases the GIL); NUMBA_NUM_THREADS (default: the
     # number of cores) is the default and the most
+    if threads is not None and (isinstance(threads, bool)
+                                or not isinstance(threads, numbers.Integral) or threads < 1):
+        raise ValueError(f"threads = {threads!r}: allowed an integer >= 1 (or None: every "
+                         "core)")
     n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
-        else max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS))
+        else min(int(threads), numba.config.NUMBA_NUM_THREADS)
     # compiles the kernel (or loads it from the cache) before the scene is packed, which uses
     # it; the time it took (here or before: cli.py) is the first run's start-up
     trace = ready(should_stop)

@@ -127,6 +127,13 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     run."""
     import os
 
+    # (the command checks its options; a caller of this function gets the same refusals:
+    # workers=0 or -1 started no worker and waited for ever, batch_groups=0 divided by zero)
+    for name, value in (("workers", workers), ("threads", threads),
+                        ("batch_groups", batch_groups)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int)
+                                  or value < 1):
+            raise SweepError(f"{name} = {value!r}: expected an integer >= 1")
     with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:
         folder = points_folder(Path(output)) if output is not None else Path(scratch)
         plan = prepare(source, folder, batch_groups, should_stop=should_stop,
