@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from .axes import SweepError, SweepSpec, load_sweep, set_key_path
+from .axes import SweepError, SweepSpec, check_count, load_sweep, set_key_path
 from .dataset import (OutputExists, PointStore, Summary, assemble, check_replaceable,
                       write_dataset)
 from .points import Point, build_points, check_batch_groups, check_scenes
@@ -131,9 +131,8 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     # workers=0 or -1 started no worker and waited for ever, batch_groups=0 divided by zero)
     for name, value in (("workers", workers), ("threads", threads),
                         ("batch_groups", batch_groups)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, int)
-                                  or value < 1):
-            raise SweepError(f"{name} = {value!r}: expected an integer >= 1")
+        if value is not None:
+            check_count(name, value)
     with tempfile.TemporaryDirectory(prefix="oceanmc-sweep-") as scratch:
         folder = points_folder(Path(output)) if output is not None else Path(scratch)
         plan = prepare(source, folder, batch_groups, should_stop=should_stop,

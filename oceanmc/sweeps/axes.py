@@ -269,10 +269,15 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
                          f"allowed: at most {MAX_POINTS:,} points in a sweep (split it into "
                          "several sweeps)")
     groups = data.get("batch_groups", 1)
-    if isinstance(groups, bool) or not isinstance(groups, int) or groups < 1:
-        raise SweepError(f"batch_groups = {groups!r}: expected an integer >= 1 (the number of "
-                         "tasks each point's batches are spread over)")
+    check_count("batch_groups", groups, " (the number of tasks each point's batches are "
+                "spread over)")
     return SweepSpec(base, base_dir, dict(settings), axes, groups)
+
+
+def check_count(name: str, value: Any, what: str = "") -> None:
+    """SweepError unless value is an integer >= 1 (a bool is not)."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        raise SweepError(f"{name} = {value!r}: expected an integer >= 1{what}")
 
 
 def _read_yaml(path: Path, what: str, kind: str) -> Any:

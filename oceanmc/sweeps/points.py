@@ -71,10 +71,14 @@ def most_batch_groups(point: Point) -> int:
 
 
 def check_batch_groups(groups: int, points: list[Point]) -> None:
-    """SweepError, before anything runs, where a point has too few batches for `groups`."""
+    """SweepError, before anything runs, where a point has too few batches for `groups` (one
+    point of each batch count is tried)."""
+    first_of: dict[int, Point] = {}
     for point in points:
-        most = most_batch_groups(point)
-        if groups > most:
+        first_of.setdefault(point.config.batches, point)
+    for point in first_of.values():
+        if point.batch_ranges(groups)[0][1] < 2 and groups > 1:
+            most = most_batch_groups(point)
             raise SweepError(
                 f"batch_groups = {groups}: point ({point.label}) has {point.config.batches} "
                 f"batches, which can be spread over at most {most} groups (each group's scene "
