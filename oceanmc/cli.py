@@ -95,18 +95,20 @@ class StopRequest:
         signal.signal(signal.SIGTERM, self)
 
 
-def _ready_or_exit(scene_files: list[Path]) -> None:
-    """Compiles the photon loop, or loads it from the cache (on a cold start the compiling
-    child packs scene_files meanwhile: run/compiling.py); the first SIGINT or SIGTERM while it
-    compiles ends the process at once (the compilation goes on in its own thread inside LLVM),
-    with exit status 130 and nothing written. The signals' handlers are as before
-    afterwards."""
+def _ready_or_exit(scene_files: list[Path], configs: list) -> None:
+    """Compiles the photon loop with the parts the scenes will use (kernel/variants.py), or
+    loads it from the cache (on a cold start the compiling child packs scene_files meanwhile:
+    run/compiling.py); the first SIGINT or SIGTERM while it compiles ends the process at once
+    (the compilation goes on in its own thread inside LLVM), with exit status 130 and nothing
+    written. The signals' handlers are as before afterwards."""
+    from .kernel.variants import union
     from .run.compiling import CompileInterrupted, ready
+    from .scene import predicted_variant
     stop = StopRequest("stopping")
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     stop.install()
     try:
-        ready(lambda: stop.requested, scene_files)
+        ready(union(map(predicted_variant, configs)), lambda: stop.requested, scene_files)
     except CompileInterrupted:
         print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
               "nothing was traced and no file was written", file=sys.stderr, flush=True)
@@ -146,7 +148,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     # kernel functions, which the compiling child process then compiles off the critical path,
     # and it packs the scenes while trace_batch compiles (run/compiling.py; packing first
     # compiled them here, 2-3 s of a cold start)
-    _ready_or_exit(configs)
+    _ready_or_exit(configs, loaded)
     scenes = []
     for path, out, config in zip(configs, outputs, loaded):
         try:

@@ -23,3 +23,14 @@ SMALL_SCENE = {
 def small_scene():
     """A fresh deep copy of a fast scene (a mutable dict each test may change)."""
     return copy.deepcopy(SMALL_SCENE)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def whole_photon_loop():
+    """The photon loop with every optional part compiled in (kernel/variants.py), made ready
+    once per session: every scene of the tests then runs on it, in this process and, through
+    the disk cache, in the processes the tests start (a scene runs on any variant that holds
+    its parts, with the same results bit for bit), instead of each set of parts compiling a
+    variant of its own. tests/test_variants.py runs scenes on their own variants."""
+    from oceanmc.run.compiling import ready
+    ready()

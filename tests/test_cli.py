@@ -169,8 +169,9 @@ def test_the_compiling_child_packs_the_scenes_it_is_given(tmp_path):
     from oceanmc.run.compiling import EVENTS_COMPILED
     cache = tmp_path / "cache"
     shutil.copytree(CACHE_DIR, cache / CACHE_DIR.name)
-    code = "import sys; from oceanmc.run.compiling import child_main; child_main(sys.argv[1:])"
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "missing.yaml"),
+    code = ("import sys; from oceanmc.run.compiling import child_main; "
+            "child_main(sys.argv[1], sys.argv[2:])")
+    done = subprocess.run([sys.executable, "-c", code, "11111", str(tmp_path / "missing.yaml"),
                            str(REPO / "configs" / "windy_case1.yaml")],
                           env=dict(ENV, OCEANMC_CACHE_DIR=str(cache)), capture_output=True,
                           text=True, timeout=600)

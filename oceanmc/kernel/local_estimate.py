@@ -166,7 +166,7 @@ def collision_depths(medium, floats, grid, work, p, layer):
 
 @internal
 def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, layer,
-                 w_scattered, rng):
+                 w_scattered, rng, with_rough_surface):
     """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene;
     in a spectral walk its weight per unit coefficient at each wavelength in work[:n_wl],
     spectral.collision_density; the point's optical depths in the scratch, collision_depths)
@@ -185,7 +185,7 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
         rough = surface.delta == 0
         for k in range(est.n_dirs):
             factor = floats[est.air_factor + k]
-            if rough and factor > 0.0:
+            if with_rough_surface is not None and rough and factor > 0.0:
                 ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
                 if t > 0.0 and iz < 0.0:
                     layer_phase(medium, floats, ints, grid, layer, ux * ix + uy * iy + uz * iz,
@@ -383,7 +383,8 @@ def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz):
 
 
 @internal
-def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng):
+def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng,
+              with_rough_surface):
     """Packet p meets the bottom: the reflected radiance w f(wi, W) T in the exact directions
     and the polar-cap averages (from_point), at every wavelength (one BRDF shape, each
     wavelength's reflectance share in its weight)."""
@@ -397,12 +398,13 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
     for j in range(n):
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
     from_point(est, grid, surface, floats, ints, bp, tally, weights(grid, ps)[3], weight, tau,
-               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng)
+               floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng,
+               with_rough_surface)
 
 
 @internal
 def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, table,
-                first, last, rng):
+                first, last, rng, with_rough_surface):
     """An inelastic emission at packet p's collision (its weights at each wavelength in
     work[3 n:4 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
     beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
@@ -414,7 +416,8 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
     if est.directions_on:
         directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
-                              tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng)
+                              tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng,
+                              with_rough_surface)
     if est.cap_on:
         cap_scores(est, grid, floats, ints, tally, one_part, work, weight, tau, p.z, p.uz,
                    table, first, last, rng)
@@ -422,7 +425,7 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
 
 @internal
 def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z,
-                          ux, uy, uz, model, beta_at, first, last, rng):
+                          ux, uy, uz, model, beta_at, first, last, rng, with_rough_surface):
     """The radiance a point source at depth z (optical depths tau, weights `weight` at the
     wavelengths first .. last - 1, none elsewhere; toward() says what it sends, a bottom's
     BRDF or an emission's phase function) sends in the exact directions."""
@@ -430,7 +433,7 @@ def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, we
     rough = surface.delta == 0
     for k in range(est.n_dirs):
         factor = floats[est.air_factor + k]
-        if rough and factor > 0.0:
+        if with_rough_surface is not None and rough and factor > 0.0:
             ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
             if t > 0.0 and iz < 0.0:
                 f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
@@ -448,7 +451,7 @@ def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, we
 
 @internal
 def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z, ux, uy, uz,
-               model, rng):
+               model, rng, with_rough_surface):
     """The radiance the bottom (BRDF `model`) at depth z sends in the exact directions
     (directions_from_point), and the polar-cap average from one direction W drawn uniformly in
     the cap (an unbiased estimate of the cap average; f is bounded for every non-mirror BRDF),
@@ -457,7 +460,7 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, 
     first, last = 0, n
     if est.directions_on:
         directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau,
-                              z, ux, uy, uz, model, 0, first, last, rng)
+                              z, ux, uy, uz, model, 0, first, last, rng, with_rough_surface)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
@@ -470,7 +473,7 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, 
                         -(tau[j] - floats[taus + level]) / mu))
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
-        if surface.delta == 0:
+        if with_rough_surface is not None and surface.delta == 0:
             # the air cap's direction drawn uniformly, its light traced back through the
             # rough sea to one in-water direction (unbiased for the cap average)
             ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))

@@ -28,7 +28,8 @@ variance differs.
 
 A spectral scene traces all its wavelengths in one history (kernel/spectral.py): a hero
 wavelength per photon (p.wavelength) samples the path, and every wavelength's weight follows it;
-the events below call spectral.* only where grid.n_wl > 1.
+the events below call spectral.* only where grid.n_wl > 1. Each optional part of the walk is
+behind its with_ argument, which compiles it in or out (kernel/variants.py).
 
 Every draw comes from the batch's own stream (kernel/rng.py), passed down as `rng`; it is
 kept apart from the packet, so split copies do not copy it. One event's scratch is the batch's
@@ -112,14 +113,14 @@ def facet_walk(surface, floats, p, rng):
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_rough_surface):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
     air = grid.air_level
     w = p.w
     score_crossing(grid, floats, ints, tally, ps, air, w, p.ux, p.uy, p.uz, p.beam)
-    if surface.delta:
+    if with_rough_surface is None or surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
         r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
@@ -145,7 +146,8 @@ def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
 
 
 @internal
-def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
+def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng, with_spectral,
+                with_inelastic):
     """Moves the packet through its segment with tau optical depths left to its next
     collision: (FLIGHT_COLLISION, layer, 0) at a collision, (FLIGHT_PLANE, plane, tau left) on
     reaching the plane ahead, or (FLIGHT_GONE, -1, 0) when a layer that does not scatter
@@ -168,17 +170,17 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
         dist = math.inf
     budget = grid.budget
     # with inelastic processes every layer has collisions (Raman scattering is the water's own)
-    if albedo > 0.0 or medium.n_channels > 1:
+    if albedo > 0.0 or (with_inelastic is not None and medium.n_channels > 1):
         s = tau * floats[medium.layer_inv_c + at]
         if s < dist:
             p.z += s * uz
-            if grid.n_wl > 1:
+            if with_spectral is not None and grid.n_wl > 1:
                 spectral.fly(medium, floats, grid, ps, p, layer, s)
             return FLIGHT_COLLISION, layer, 0.0
         tau -= dist * c
-        if grid.n_wl > 1 and dist < math.inf:
+        if with_spectral is not None and grid.n_wl > 1 and dist < math.inf:
             spectral.fly(medium, floats, grid, ps, p, layer, dist)
-    elif grid.n_wl > 1:
+    elif with_spectral is not None and grid.n_wl > 1:
         if spectral.attenuate(medium, floats, grid, tally, ps, p, layer, dist):
             return FLIGHT_GONE, -1, 0.0
     elif dist == math.inf:
@@ -195,7 +197,7 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
         else:
             score(grid, tally, ps, budget + BUDGET_LAYERS + layer, p.w * (1.0 - transmitted))
             p.w *= transmitted
-    if grid.n_wl > 1:
+    if with_spectral is not None and grid.n_wl > 1:
         spectral.settle(medium, floats, grid, tally, ps, p, layer)
     if dist == math.inf:  # b so small that tau / c overflowed: the packet never collides
         score(grid, tally, ps, budget + BUDGET_LOST_BELOW, p.w)
@@ -206,49 +208,59 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng):
 
 @internal
 def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, stack, stack_ps,
-            n_stacked, p, layer, events, rng, rng_emitted):
+            n_stacked, p, layer, events, rng, rng_emitted, with_spectral, with_inelastic,
+            with_rough_surface, with_local_estimates):
     """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
     channels/: they take their share of every wavelength and emit it, light the packet carries
     on or that waits on the stack in packets of its own), absorption (implicit: weight times
     the albedo), elastic scattering, roulette. tally: the batch's tally row, every part of it.
     Returns (alive, optical depth to the next collision, stack height)."""
     albedo = floats[medium.layer_albedo + layer * medium.n_wl + p.wavelength]
+    # (each use of these two is behind its with_ argument: Numba prunes a branch on an argument
+    # of NoneType, not on a variable computed from one; kernel/variants.py)
     estimates = (est.directions_on or est.cap_on) and albedo > 0.0
     # the packet carries its collisions' emissions on where it goes on with its weight
     # (channels/inelastic.py); settled first, so that the hero's posterior is exact
     carrying = (medium.n_channels > 1 and ctrl.carry_emissions != 0 and not ctrl.analog
                 and albedo > 0.0)
-    if carrying:
+    if with_inelastic is not None and with_spectral is not None and carrying:
         spectral.settle(medium, floats, grid, tally, ps, p, layer)
-    if grid.n_wl > 1 and (estimates or medium.n_channels > 1):
+    if with_spectral is not None and grid.n_wl > 1 and (
+            (with_local_estimates is not None and estimates)
+            or (with_inelastic is not None and medium.n_channels > 1)):
         # the collision's weight per unit coefficient at every wavelength, which the local
         # estimates (times b) and the inelastic channels (times theirs) read
         spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl])
-    if grid.n_parts > 1:
+    if with_inelastic is not None and grid.n_parts > 1:
         # a new point: its cap transmissions are not computed yet
         # (local_estimate.cap_transmissions)
         local_estimate.cap_transmissions(grid, work)[2][0] = 0.0
-    if est.directions_on or est.cap_on:   # read by the local estimates and the emissions'
+    if with_local_estimates is not None and (est.directions_on or est.cap_on):
+        # (read by the local estimates and the emissions')
         local_estimate.collision_depths(medium, floats, grid, work, p, layer)
-    if estimates:
+    if with_local_estimates is not None and estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
-                                    p, layer, p.w * albedo, rng)
-    n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
-                              stack, stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted)
-    if carrying:
+                                    p, layer, p.w * albedo, rng, with_rough_surface)
+    if with_inelastic is not None:
+        n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
+                                  stack, stack_ps, n_stacked, p, ps, layer, carrying,
+                                  rng_emitted, with_rough_surface, with_local_estimates)
+    if with_inelastic is not None and with_spectral is not None and carrying:
         spectral.hero_posterior(medium, floats, grid, ps, layer,
                                 work[grid.n_wl:2 * grid.n_wl])
     w = p.w
     budget = grid.budget
     if ctrl.analog:
         if uniform(rng) >= albedo:
-            if grid.n_wl > 1:
+            if with_spectral is not None and grid.n_wl > 1:
                 spectral.lose(grid, tally, ps, layer)
             else:
                 score(grid, tally, ps, budget + BUDGET_LAYERS + layer, w)
             return False, 0.0, n_stacked
     else:
-        if albedo <= 0.0:   # a layer that only scatters inelastically (channels.emit)
+        if with_inelastic is not None and with_spectral is not None and albedo <= 0.0:
+            # a layer that only scatters inelastically (channels.emit; without inelastic
+            # channels a layer of albedo 0 has no collisions: free_flight)
             spectral.lose(grid, tally, ps, layer)
             return False, 0.0, n_stacked
         scattered = w * albedo
@@ -257,19 +269,19 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
         p.w = scattered
     ux, uy, uz = p.ux, p.uy, p.uz
     density = channels.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer,
-                               carrying, rng)
-    if carrying:
+                               carrying, rng, with_spectral)
+    if with_inelastic is not None and carrying:
         channels.carry(medium, grid, floats, tally, work, ps, p, layer,
                        ux * p.ux + uy * p.uy + uz * p.uz, density)
     p.beam = 0
     tau = exponential(rng)
-    if grid.n_wl > 1:
+    if with_spectral is not None and grid.n_wl > 1:
         if not spectral.survives_roulette(medium, floats, ctrl, grid, tally, ps, p, layer, rng):
             return False, tau, n_stacked
     elif not survives_roulette(ctrl, p, rng):
         return False, tau, n_stacked
     if events >= ctrl.max_events:
-        if grid.n_wl > 1:
+        if with_spectral is not None and grid.n_wl > 1:
             spectral.settle(medium, floats, grid, tally, ps, p, layer)
         score(grid, tally, ps, budget + BUDGET_TRUNCATED, p.w)
         return False, tau, n_stacked
@@ -277,13 +289,14 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
 
 
 @internal
-def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_spectral,
+                     with_rough_surface):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
     an analog walk; a rough surface: one sample of its facet walk). Returns whether the packet
     goes on."""
-    if surface.delta:
+    if with_rough_surface is None or surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
         r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
@@ -305,24 +318,26 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
     p.uy = ry
     p.uz = rz
     p.seg = 0
-    if grid.n_wl > 1:
+    if with_spectral is not None and grid.n_wl > 1:
         spectral.carry(grid, ps, p)
     return True
 
 
 @internal
 def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp, tally, ps,
-                      work, p, rng):
+                      work, p, rng, with_spectral, with_rough_surface, with_reflecting_bottom,
+                      with_local_estimates):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
     budget = grid.budget
-    if not bottom.reflects:  # black (an infinitely deep bottom is never met)
+    if with_reflecting_bottom is None or not bottom.reflects:
+        # black (an infinitely deep bottom is never met)
         score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)
         return False
-    if est.directions_on or est.cap_on:
+    if with_local_estimates is not None and (est.directions_on or est.cap_on):
         local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
-                                 ps, work, p, rng)
+                                 ps, work, p, rng, with_rough_surface)
     u1 = uniform(rng)
     u2 = uniform(rng)
     ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2)
@@ -334,10 +349,10 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
         if uniform(rng) >= rho:
             score(grid, tally, ps, budget + BUDGET_BOTTOM, p.w)   # (settled on the plane)
             return False
-        if grid.n_wl > 1:
+        if with_spectral is not None and grid.n_wl > 1:
             spectral.reflect(grid, floats, tally, ps, p, 1.0,
                              brdf.sampled_mirror(bottom.model, bp, u1))
-    elif grid.n_wl > 1:
+    elif with_spectral is not None and grid.n_wl > 1:
         spectral.reflect(grid, floats, tally, ps, p, rho,
                          brdf.sampled_mirror(bottom.model, bp, u1))
     else:
@@ -365,14 +380,14 @@ def cross_plane(medium, grid, floats, ints, tally, ps, p, target):
 
 @internal
 def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_ps, n_stacked, p,
-                     level, rng):
+                     level, rng, with_spectral):
     """A packet reflected at the surface or the bottom crosses its plane's tally level again,
     may be split, and plays roulette; returns (alive, stack height)."""
     if level >= 0 and p.w > 0.0:
         score_crossing(grid, floats, ints, tally, ps, level, p.w, p.ux, p.uy, p.uz, p.beam)
     if ctrl.splitting and p.w > ctrl.split_weight:
         n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
-    if grid.n_wl > 1:
+    if with_spectral is not None and grid.n_wl > 1:
         return spectral.survives_roulette(medium, floats, ctrl, grid, tally, ps, p,
                                           ints[medium.segment_layer + p.seg], rng), n_stacked
     return survives_roulette(ctrl, p, rng), n_stacked
@@ -380,8 +395,9 @@ def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_p
 
 @batch
 def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
-                floats, ints, n_photons, start, work_budget, rng, rng_emitted, beam_in,
-                tally_row, packet_row, stack, states, work):
+                floats, ints, with_spectral, with_inelastic, with_rough_surface,
+                with_reflecting_bottom, with_local_estimates, n_photons, start, work_budget,
+                rng, rng_emitted, beam_in, tally_row, packet_row, stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
     per photon and per scattering event): returns (next photon index, scattering events).
@@ -402,7 +418,8 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
     packet's light may be of several parts, packet.shares; every scorer splits what it scores
     by them, tally.deposit). The records come as one-row
     arrays, the scene's tables as one float pool and one int pool (kernel/records.py); the GIL
-    is released, so batches run in parallel threads."""
+    is released, so batches run in parallel threads. The with_ arguments say which optional
+    parts of the loop are compiled in (kernel/variants.py)."""
     medium, surface, bottom, sky = medium_row[0], surface_row[0], bottom_row[0], sky_row[0]
     grid, est, ctrl, p = grid_row[0], est_row[0], ctrl_row[0], packet_row[0]
     bp = floats[bottom.params:]   # the BRDF's parameters, at offsets of their own
@@ -444,15 +461,16 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         packet.launch(p, w, ux, uy, uz, not from_sky)
         tally = tally_row
         from_air = i < 0 or from_sky or not beam_once
-        if grid.n_wl > 1:
+        if with_spectral is not None and grid.n_wl > 1:
             spectral.start(grid, floats, ps, p, from_sky, rng)
-        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng):
+        if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng,
+                                           with_rough_surface):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
             beam_in[0], beam_in[1], beam_in[2], beam_in[3] = w_sun_in, sx, sy, sz
             continue
-        if grid.n_wl > 1:
+        if with_spectral is not None and grid.n_wl > 1:
             spectral.carry(grid, ps, p)
         if ctrl.splitting and p.w > ctrl.split_weight:
             n_stacked = split(ctrl, grid, stack, stack_ps, n_stacked, p, ps)
@@ -465,21 +483,26 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
             walk_events = 0   # this packet's collisions, against the max_events safety limit
             while alive and p.w > 0.0:
                 outcome, where, tau = free_flight(medium, ctrl, grid, floats, ints, tally, ps, p,
-                                                  tau, draws)
+                                                  tau, draws, with_spectral, with_inelastic)
                 if outcome == FLIGHT_COLLISION:
                     walk_events += 1
                     alive, tau, n_stacked = collide(medium, surface, ctrl_row[p.seg], grid,
                                                     est, floats, ints, tally, ps, work, stack,
                                                     stack_ps, n_stacked, p, where, walk_events,
-                                                    draws, rng_emitted)
+                                                    draws, rng_emitted, with_spectral,
+                                                    with_inelastic, with_rough_surface,
+                                                    with_local_estimates)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
                         alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
-                                                 draws)
+                                                 draws, with_spectral, with_rough_surface)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
-                                                  floats, ints, bp, tally, ps, work, p, draws)
+                                                  floats, ints, bp, tally, ps, work, p, draws,
+                                                  with_spectral, with_rough_surface,
+                                                  with_reflecting_bottom,
+                                                  with_local_estimates)
                     elif ctrl.depth_windows:
                         n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
                                                weight_window.copies(ctrl_row[p.seg], grid, p,
@@ -488,7 +511,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                         alive, n_stacked = after_reflection(medium, ctrl_row[p.seg], grid,
                                                             floats, ints, tally, ps, stack,
                                                             stack_ps, n_stacked, p, level,
-                                                            draws)
+                                                            draws, with_spectral)
                 else:
                     alive = False
             events += walk_events

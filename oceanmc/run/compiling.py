@@ -94,6 +94,7 @@ from ..kernel.compile import CACHE_DIR, CACHE_WRITABLE
 from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
 from ..kernel.transport import trace_batch
+from ..kernel.variants import EVERYTHING, PARTS, Variant
 
 COMPILE_NOTICE_AFTER_S = 1.0
 # LLVM's optimisation level for the kernel's IR (machine code is still generated at Numba's
@@ -108,10 +109,11 @@ class CompileInterrupted(Exception):
     """The user asked to stop while the kernel was compiling; nothing was traced."""
 
 
-def _argument_types() -> dict[str, numba.types.Type]:
+def _argument_types(variant: Variant) -> dict[str, numba.types.Type]:
     """The Numba type of each kernel argument by its name, the same in every kernel function
     (a record by its component's name, its one-row array by name_row, the scene's pools
-    `floats` and `ints`, the packet p and its spectral state ps, ...)."""
+    `floats` and `ints`, the packet p and its spectral state ps, ...; with_<part>: boolean
+    where the variant compiles the part in, NoneType where it does not)."""
     f8 = numba.typeof(np.zeros(1))
     types = {"floats": f8, "ints": numba.typeof(np.zeros(1, dtype=np.int64)),
              "bp": f8, "tally": f8, "tally_row": f8, "ps": f8, "work": f8, "beam_in": f8,
@@ -132,6 +134,8 @@ def _argument_types() -> dict[str, numba.types.Type]:
         row = numba.typeof(np.zeros(1, dtype=dtype))
         types[name], types[f"{name}_row"] = row.dtype, row
     types["p"], types["stack"] = types["packet"], types["packet_row"]
+    for part, on in zip(PARTS, variant):
+        types[f"with_{part}"] = numba.boolean if on else numba.none
     return types
 
 
@@ -140,48 +144,83 @@ def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
     return tuple(types[name] for name in inspect.signature(function.py_func).parameters)
 
 
-def parts() -> dict[str, list[tuple]]:
+def parts(variant: Variant) -> dict[str, list[tuple]]:
     """(dispatcher, argument types) to compile, in order: `events` (in the child process when
     there is one: the walk's events but the collision, and trace_batch's other callees),
     `collision` and `entry` (the entry points, trace_batch first) here. A function compiled in
     `events` with other argument types than trace_batch calls it with would only be compiled
     again here, at no other cost (checked once: none is)."""
-    types = _argument_types()
+    types = _argument_types(variant)
+    spectral_start = (spectral.start,) if variant.spectral else ()
     return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
         ("events", (transport.enter_from_air, transport.leave_or_reflect,
                     transport.reflect_at_bottom, transport.free_flight, transport.cross_plane,
                     transport.after_reflection, transport.split_into, sources.sky_direction,
-                    spectral.start, component_density, transmittance)),
+                    *spectral_start, component_density, transmittance)),
         ("collision", (transport.collide,)),
         ("entry", (trace_batch, component_density, transmittance)))}
 
 
-def compile_part(name: str) -> None:
-    """Compiles one part at the kernel's optimisation level (the child process runs this)."""
+def compile_part(name: str, variant: Variant) -> None:
+    """Compiles one part of a variant at the kernel's optimisation level (the child process
+    runs this)."""
     previous = numba.config.OPT
     numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
     try:
-        for dispatcher, sig in parts()[name]:
+        for dispatcher, sig in parts(variant)[name]:
             dispatcher.compile(sig)
     finally:
         numba.config.OPT = previous
 
 
-def _in_cache() -> bool:
-    """Whether the disk cache already holds the photon loop (then loading it takes 0.3 s)."""
-    return any(CACHE_DIR.rglob(f"transport.{trace_batch.__name__}-*.nbi"))
+def _entry_signature(variant: Variant) -> tuple:
+    return parts(variant)["entry"][0][1]
+
+
+def _loaded(variant: Variant) -> bool:
+    """Loads trace_batch's variant from the disk cache into this process if the cache holds
+    it (0.3 s), as Numba's Dispatcher.compile does with a cache hit; a miss costs a read of the
+    cache's index. Whether it is here now."""
+    sig = _entry_signature(variant)
+    if sig in trace_batch.overloads:
+        return True
+    try:
+        cres = trace_batch._cache.load_overload(sig, trace_batch.targetctx)
+    except AttributeError:   # a Numba without this (private) interface: compile() loads it
+        return False
+    if cres is None:
+        return False
+    trace_batch.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+    trace_batch.add_overload(cres)
+    return True
+
+
+def held_variant(variant: Variant) -> Variant | None:
+    """The variant of trace_batch, in this process or in the disk cache, that holds every part
+    of `variant`: the nearest (Variant.supersets) of those here, else of those on disk (then
+    loaded); None when there is none. A scene runs on any variant that holds its parts, with
+    the same results bit for bit (kernel/variants.py), and compiles its own only when none is
+    at hand."""
+    return _here(variant) or next((candidate for candidate in variant.supersets()
+                                   if _loaded(candidate)), None)
+
+
+def _here(variant: Variant) -> Variant | None:
+    """The nearest variant holding `variant` that this process has compiled or loaded."""
+    return next((candidate for candidate in variant.supersets()
+                 if _entry_signature(candidate) in trace_batch.overloads), None)
 
 
 EVENTS_COMPILED = "events compiled"
 
 
-def child_main(scene_files: list[str]) -> None:
-    """The compiling child process: compiles the part `events` into the shared cache, says so
-    on stdout, then packs the scenes of scene_files while the parent compiles trace_batch
-    (their tables, cached on disk, are then the parent's for the asking: a profile's or a
-    windy sea's take seconds to build). A scene it cannot pack is left to the parent, which
-    reports why."""
-    compile_part("events")
+def child_main(variant: str, scene_files: list[str]) -> None:
+    """The compiling child process: compiles the part `events` of the variant (its parts as
+    0s and 1s in PARTS' order) into the shared cache, says so on stdout, then packs the scenes
+    of scene_files while the parent compiles trace_batch (their tables, cached on disk, are
+    then the parent's for the asking: a profile's or a windy sea's take seconds to build). A
+    scene it cannot pack is left to the parent, which reports why."""
+    compile_part("events", Variant(*(flag == "1" for flag in variant)))
     print(EVENTS_COMPILED, flush=True)
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no one reads on
     from ..config import load_config
@@ -193,13 +232,15 @@ def child_main(scene_files: list[str]) -> None:
             pass
 
 
-def _start_child(scene_files: Sequence[Path]) -> subprocess.Popen | None:
+def _start_child(variant: Variant, scene_files: Sequence[Path]) -> subprocess.Popen | None:
     """The compiling child process (child_main), if this machine has a core to spare for it."""
     if (os.cpu_count() or 1) < 2 or not CACHE_WRITABLE:   # (they meet in the disk cache)
         return None
-    code = "import sys; from oceanmc.run.compiling import child_main; child_main(sys.argv[1:])"
+    code = ("import sys; from oceanmc.run.compiling import child_main; "
+            "child_main(sys.argv[1], sys.argv[2:])")
+    flags = "".join("1" if on else "0" for on in variant)
     try:
-        return subprocess.Popen([sys.executable, "-c", code, *map(str, scene_files)],
+        return subprocess.Popen([sys.executable, "-c", code, flags, *map(str, scene_files)],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.DEVNULL, text=True,
                                 env=dict(os.environ, OCEANMC_CACHE_DIR=str(CACHE_DIR.parent)))
@@ -228,26 +269,36 @@ def startup_seconds() -> float:
     return seconds
 
 
-def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[Path] = ()):
-    """trace_batch's compiled entry point (plain trace_batch under NUMBA_DISABLE_JIT=1). On a
-    cold start the compiling child also packs scene_files (child_main), and this returns once
-    it has, so that their packing here finds their tables in the disk caches."""
+def ready(variant: Variant = EVERYTHING, should_stop: Callable[[], bool] | None = None,
+          scene_files: Sequence[Path] = ()) -> tuple[Callable, Variant]:
+    """(trace_batch's compiled entry point, its variant) for a scene that uses the parts of
+    `variant`: the nearest variant holding them that this process has or the disk cache holds
+    (held_variant), else this one, compiled (plain trace_batch, EVERYTHING under
+    NUMBA_DISABLE_JIT=1). The entry point takes the variant's kernel_args() after the pools.
+    On a cold start the compiling child also packs scene_files (child_main), and this returns
+    once it has, so that their packing here finds their tables in the disk caches."""
     if not hasattr(trace_batch, "overloads"):
-        return trace_batch
-    entry_sig = parts()["entry"][0][1]
-    if any(sig not in f.overloads for f, sig in parts()["entry"]):
+        return trace_batch, EVERYTHING
+    here = _here(variant)
+    if here is not None and all(sig in f.overloads for f, sig in parts(here)["entry"]):
+        return trace_batch.overloads[_entry_signature(here)].entry_point, here
+    t0 = time.perf_counter()
+    held = held_variant(variant)
+    cold = held is None
+    held = held or variant
+    if cold or any(sig not in f.overloads for f, sig in parts(held)["entry"]):
         failure = []
         child = None
 
         def compile_all():
             nonlocal child
             try:
-                if not _in_cache():
-                    child = _start_child(scene_files)
+                if cold:
+                    child = _start_child(held, scene_files)
                     if child is not None:
-                        compile_part("collision")   # while the child compiles the other events
+                        compile_part("collision", held)   # while the child compiles the events
                         _events_compiled(child)
-                compile_part("entry")
+                compile_part("entry", held)
                 if child is not None:   # its packing of the scenes
                     try:
                         child.wait(timeout=CHILD_TIMEOUT_S)
@@ -257,7 +308,6 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
                 failure.append(exc)
 
         worker = threading.Thread(target=compile_all, name="oceanmc-compile", daemon=True)
-        t0 = time.perf_counter()
         worker.start()
         said = 0.0
         try:
@@ -269,8 +319,9 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
                 if worker.is_alive() and elapsed >= COMPILE_NOTICE_AFTER_S \
                         and elapsed - said >= 5.0:
                     if not said:
-                        print(f"oceanmc: compiling the photon loop (once per oceanmc version on "
-                              f"this machine; cached in {CACHE_DIR})", file=sys.stderr,
+                        print(f"oceanmc: compiling the photon loop with its parts for this "
+                              f"scene ({held.label}; once per oceanmc version and set of parts "
+                              f"on this machine; cached in {CACHE_DIR})", file=sys.stderr,
                               flush=True)
                     else:
                         print(f"oceanmc: still compiling, {elapsed:.0f} s", file=sys.stderr,
@@ -282,8 +333,8 @@ def ready(should_stop: Callable[[], bool] | None = None, scene_files: Sequence[P
             raise
         if failure:
             raise failure[0]
-        _unreported_startup[0] += time.perf_counter() - t0
         if said:
             print(f"oceanmc: photon loop compiled in {time.perf_counter() - t0:.1f} s",
                   file=sys.stderr, flush=True)
-    return trace_batch.overloads[entry_sig].entry_point
+    _unreported_startup[0] += time.perf_counter() - t0
+    return trace_batch.overloads[_entry_signature(held)].entry_point, held

@@ -329,19 +329,23 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
                          "core)")
     n_threads = numba.config.NUMBA_NUM_THREADS if threads is None \
         else min(int(threads), numba.config.NUMBA_NUM_THREADS)
-    # compiles the kernel (or loads it from the cache) before the scene is packed, which uses
-    # it; the time it took (here or before: cli.py) is the first run's start-up
-    trace = ready(should_stop)
-    startup = startup_seconds()
+    # compiles the kernel's variant for the scene (or loads it from the cache) before the scene
+    # is packed, which uses it; the time it took (here or before: cli.py) is the first run's
+    # start-up
+    trace, variant = ready(config.scene.variant if isinstance(config, PreparedRun)
+                           else scene.predicted_variant(config), should_stop)
     run = config if isinstance(config, PreparedRun) else prepare(config)
     config, sc = run.config, run.scene
+    if not variant.holds(sc.variant):   # the prediction from the config missed a part
+        trace, variant = ready(sc.variant, should_stop)
+    startup = startup_seconds()
     if not 0 <= first_batch < config.batches:
         raise ValueError(f"first_batch = {first_batch}: allowed 0 .. {config.batches - 1}")
     batches = Batches(run, first_batch)
     if resume_state is not None:
         batches.restore(resume_state)
     views = [tally_views(sc.grid, batches.tallies, j) for j in range(len(config.wavelengths))]
-    args = sc.kernel_args()
+    args = sc.kernel_args() + variant.kernel_args()
 
     def result_of(wall: float) -> Result:
         """The leading whole batches, and the state of the later ones begun."""

@@ -11,6 +11,7 @@ import numpy as np
 from .. import config as cfg
 from .. import optics
 from ..kernel.records import ESTIMATOR, SPLIT_STACK_ROWS, merge, record
+from ..kernel.variants import Variant
 from . import bottom, estimates, grid, medium, sky, surface, weight_window
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
@@ -56,6 +57,31 @@ class Scene:
         ctrl = self.estimator[0]
         uses = ctrl["splitting"] or ctrl["depth_windows"] or self.medium[0]["n_channels"] > 1
         return SPLIT_STACK_ROWS if uses else 1
+
+    @property
+    def variant(self) -> Variant:
+        """The optional parts of the photon loop that this scene's records may run
+        (kernel/variants.py): trace it only on a variant that holds them."""
+        g, est = self.grid[0], self.estimates[0]
+        return Variant(spectral=bool(g["n_wl"] > 1),
+                       inelastic=bool(self.medium[0]["n_channels"] > 1 or g["n_parts"] > 1),
+                       rough_surface=not self.surface[0]["delta"],
+                       reflecting_bottom=bool(self.bottom[0]["reflects"]),
+                       local_estimates=bool(est["directions_on"] or est["cap_on"]))
+
+
+def predicted_variant(config: cfg.SceneConfig) -> Variant:
+    """The optional parts of the photon loop that the scene will use, from its config alone:
+    the loop is compiled before (or while) the scenes are packed. Only a prediction: the run
+    checks it against the packed scene's own (Scene.variant), and a part it missed costs a
+    second compilation, never a wrong result."""
+    inelastic = config.water.inelastic
+    return Variant(spectral=len(config.wavelengths) > 1,
+                   inelastic=inelastic is not None and bool(inelastic.processes()),
+                   rough_surface=not surface.pack(config.surface, config.n_water)[0]["delta"],
+                   reflecting_bottom=config.bottom.model not in ("none", "black"),
+                   local_estimates=bool(config.tallies.local_directions_deg)
+                   or config.nadir_local)
 
 
 def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:
@@ -110,4 +136,4 @@ def build(config: cfg.SceneConfig,
                  float(column.upward or 0.0))
 
 
-__all__ = ["Scene", "Grid", "build", "make_grid"]
+__all__ = ["Scene", "Grid", "build", "make_grid", "predicted_variant"]

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+from ..kernel.variants import Variant, union
 from .axes import SweepError, SweepSpec, check_count, load_sweep, set_key_path
 from .dataset import (OutputExists, PointStore, Summary, assemble, check_replaceable,
                       write_dataset)
@@ -35,6 +36,7 @@ class Plan:
     spec: SweepSpec
     points: list[Point]
     store: PointStore
+    variant: Variant        # the photon loop's variant that every point runs on
     summaries: dict[str, Summary] = field(default_factory=dict)
     errors: dict[str, str] = field(default_factory=dict)
 
@@ -61,6 +63,7 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
     sweep will write, which must not hold anything it would lose (OutputExists, before the
     kernel is compiled). should_stop: checked while the kernel compiles (CompileInterrupted)."""
     from ..run.compiling import ready
+    from ..scene import predicted_variant
 
     spec = load_sweep(source)
     if batch_groups is not None:
@@ -69,10 +72,12 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
     check_batch_groups(spec.batch_groups, points)
     if replacing is not None:
         check_replaceable(replacing, store_folder, spec)
-    ready(should_stop)   # compiles here, once, into the disk cache that local workers load from
+    # compiles here, once, a variant that every point runs on, into the disk cache that local
+    # workers load from
+    variant = ready(union(predicted_variant(point.config) for point in points), should_stop)[1]
     check_scenes(points)
     store = PointStore(store_folder)
-    plan = Plan(spec, points, store)
+    plan = Plan(spec, points, store, variant)
     for point in points:
         summary = store.finished(point)
         if summary is not None:
@@ -97,7 +102,8 @@ def run(plan: Plan, client, threads: int | None = None, progress: bool = False,
     todo = plan.todo
     if todo:
         run_points(client, plan.store, todo, plan.spec.batch_groups, threads, on_done, progress,
-                   len(plan.points), len(plan.points) - len(todo), workers_write, should_stop)
+                   len(plan.points), len(plan.points) - len(todo), workers_write, plan.variant,
+                   should_stop)
 
 
 def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None, *,

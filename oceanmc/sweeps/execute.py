@@ -24,19 +24,21 @@ from typing import Callable
 
 from tqdm import tqdm
 
+from ..kernel.variants import Variant
 from .dataset import PointStore, Summary
 from .points import Point
 
 POLL_S = 0.2
 
 
-def load_kernel() -> float:
-    """Compiles the photon loop or loads it from the on-disk cache (run in every worker once, so
-    that the first point's run time is its own); returns the seconds it took."""
+def load_kernel(variant: Variant) -> float:
+    """Compiles the photon loop's variant or loads it from the on-disk cache (run in every
+    worker once, so that the first point's run time is its own); returns the seconds it
+    took."""
     from ..run.compiling import ready
     t0 = time.perf_counter()
     _no_process_lock_for_tqdm()
-    ready()
+    ready(variant)
     return time.perf_counter() - t0
 
 
@@ -99,7 +101,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, client
 def run_points(client, store: PointStore, todo: list[Point], groups: int, threads: int | None,
                on_done: Callable[[Point, Summary | None, str | None], None],
                progress: bool, total: int, skipped: int, workers_write: bool,
-               should_stop: Callable[[], bool] | None = None) -> None:
+               variant: Variant, should_stop: Callable[[], bool] | None = None) -> None:
     """Submits every point (or its unfinished batch groups) and calls on_done(point, summary,
     None) or on_done(point, None, error) as each point ends, whatever the order. workers_write:
     the workers see the store's folder (a local cluster) and write the results files.
@@ -112,7 +114,7 @@ def run_points(client, store: PointStore, todo: list[Point], groups: int, thread
 
     if stopping():
         return
-    client.run(load_kernel)
+    client.run(load_kernel, variant)
     task_of = {}       # future -> (point, batch range)
     remaining = {}     # point key -> batch ranges still running
     ranges_of = {}

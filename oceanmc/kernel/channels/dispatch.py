@@ -5,17 +5,19 @@ from . import elastic, inelastic
 
 
 @internal
-def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng):
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng,
+            with_spectral):
     """The elastic channel, every scene's (scene/medium.py packs it first as channel 0): the
     packet's new direction and weights; returns the density the direction was drawn with
     when the packet carries emissions (elastic.scatter)."""
     return elastic.scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer,
-                           carrying, rng)
+                           carrying, rng, with_spectral)
 
 
 @internal
 def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack, stack_ps,
-         n_stacked, p, ps, layer, carrying, rng_emitted):
+         n_stacked, p, ps, layer, carrying, rng_emitted, with_rough_surface,
+         with_local_estimates):
     """Every inelastic channel (1 .. n_channels - 1; their models: MEDIUM channel_model, all
     run by channels/inelastic.py) of a collision of packet p, before its implicit capture;
     work[:n_wl] holds the collision's weight per unit coefficient at every wavelength
@@ -26,7 +28,8 @@ def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
     for channel in range(1, medium.n_channels):
         n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
                                    tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,
-                                   carrying, rng_emitted)
+                                   carrying, rng_emitted, with_rough_surface,
+                                   with_local_estimates)
     return n_stacked
 
 

@@ -12,7 +12,8 @@ from ..rng import uniform
 
 
 @internal
-def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng):
+def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carrying, rng,
+            with_spectral):
     """The packet's new direction, and its weights for it (see channels/__init__.py).
     carrying: the packet carries a collision's emissions on (channels/inelastic.py carry),
     and work[n_wl:2 n_wl] holds the hero's posterior (spectral.hero_posterior); returns the
@@ -29,7 +30,7 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
         angle = tabulated.clamped_angle(cos_s)
     else:
         u_pick = uniform(rng) if ints[medium.comp_count + layer] > 1 else 0.0
-        if spectral_walk:
+        if with_spectral is not None and spectral_walk:
             k_s = phase.pick(medium, floats, ints, layer, h, u_pick)
             cos_s, angle, psi_s, node_s = phase.sample_angle(medium, floats, ints, k_s,
                                                              uniform(rng))
@@ -38,7 +39,7 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
             angle = 0.0
         nx, ny, nz = turn(ux, uy, uz, cos_s, uniform(rng))
     density = 0.0
-    if spectral_walk:
+    if with_spectral is not None and spectral_walk:
         keep = 1.0
         cone_density = 0.0
         if ctrl.upward:

@@ -55,7 +55,8 @@ from ..tally import deposit_all, spectral_at
 
 @internal
 def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
-         stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted):
+         stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted, with_rough_surface,
+         with_local_estimates):
     """Channel `channel` (1 ..) of a collision of packet p in `layer`, whose weights per unit
     coefficient are work[:n] (spectral.collision_density): books what it takes from each
     wavelength (split by the packet's parts), scores the local estimates of the emission
@@ -120,7 +121,7 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
             kept[i] = emission[i]
     part = channel
     child_part = part * part_size
-    if estimate:
+    if with_local_estimates is not None and estimate:
         # the expected emission's light straight to the levels above and out (the packet
         # that carries the emission, or the emitted packet, scores its light after it
         # scatters)
@@ -128,7 +129,8 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
                                    tally_row[child_part:child_part + part_size], work, p, layer,
                                    medium.channel_beta + channel, est.emission_tables + k,
                                    ints[medium.channel_emits + 2 * k],
-                                   ints[medium.channel_emits + 2 * k + 1], rng_emitted)
+                                   ints[medium.channel_emits + 2 * k + 1], rng_emitted,
+                                   with_rough_surface)
     if not spawn:
         return n_stacked
     shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)

@@ -1,0 +1,73 @@
+"""The photon loop's variants (kernel/variants.py): a scene compiles only the optional parts of
+the loop it uses, and runs on any variant that holds them with the same results bit for bit."""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from oceanmc.config import load_config
+from oceanmc.kernel.variants import EVERYTHING, PARTS, Variant, union
+from oceanmc.run.simulation import prepare
+from oceanmc.scene import predicted_variant
+
+REPO = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, PYTHONPATH=str(REPO))
+TIMING = {"wall_time_s", "startup_time_s", "photons_per_s", "threads"}
+
+
+def test_supersets_are_the_variants_that_hold_it_nearest_first():
+    plain = Variant(*(False,) * len(PARTS))
+    assert len(plain.supersets()) == 2 ** len(PARTS)
+    assert plain.supersets()[0] == plain and plain.supersets()[-1] == EVERYTHING
+    spectral = plain._replace(spectral=True)
+    found = spectral.supersets()
+    assert found[0] == spectral and len(found) == 2 ** (len(PARTS) - 1)
+    assert all(v.holds(spectral) for v in found)
+    assert [sum(v) for v in found] == sorted(sum(v) for v in found)
+    assert not plain.holds(spectral) and EVERYTHING.holds(plain)
+    assert union([]) == plain
+    assert union([spectral, plain._replace(local_estimates=True)]) == \
+        plain._replace(spectral=True, local_estimates=True)
+    assert plain.label == "plain" and spectral.kernel_args()[0] is True
+    assert spectral.kernel_args()[1:] == (None,) * (len(PARTS) - 1)
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in (REPO / "configs").glob("*.yaml")))
+def test_the_prediction_from_the_config_is_the_packed_scenes_own(name):
+    """`oceanmc run` compiles the variant it predicts from the configs before it packs them;
+    a wrong prediction would compile a second variant (the run checks the packed scene's)."""
+    config = load_config(REPO / "configs" / f"{name}.yaml")
+    assert predicted_variant(config) == prepare(config).scene.variant
+
+
+def test_a_scene_on_its_own_variant_gives_the_same_file_as_on_the_whole_loop(tmp_path,
+                                                                             small_scene):
+    """The small scene (one wavelength, flat sea, Lambertian bottom, the nadir cap's local
+    estimate) compiled cold with only its parts (the notice names them), and run again here on
+    the whole loop (the session's): every dataset and attribute the same, bit for bit, but the
+    timings."""
+    import oceanmc
+    from oceanmc.run.compiling import ready
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(yaml.safe_dump(small_scene))
+    own = subprocess.run([sys.executable, "-m", "oceanmc", "run", str(scene), "-o", "own.h5"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=900,
+                         env=dict(ENV, OCEANMC_CACHE_DIR=str(tmp_path / "empty-cache")))
+    assert own.returncode == 0, own.stderr
+    assert "compiling the photon loop with its parts for this scene (reflecting bottom, local " \
+        "estimates;" in own.stderr
+    assert ready(predicted_variant(load_config(scene)))[1] == EVERYTHING
+    oceanmc.simulate(scene).save(tmp_path / "whole.h5")
+    with h5py.File(tmp_path / "own.h5") as a, h5py.File(tmp_path / "whole.h5") as b:
+        mine = {k: a.attrs[k] for k in a.attrs if k not in TIMING | {"config_file"}}
+        assert mine == {k: b.attrs[k] for k in b.attrs if k not in TIMING | {"config_file"}}
+        names = []
+        a.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        assert len(names) > 50
+        for name in names:
+            assert np.array_equal(a[name][()], b[name][()], equal_nan=True), name
