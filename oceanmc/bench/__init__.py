@@ -36,7 +36,7 @@ from .scenes import SKY_SPOT, scenes, sky_spot_map, sky_spot_scenes, startup_sce
 def _startup(configs_dir: Path, quick: bool, say) -> dict:
     say("start-up ...")
     with tempfile.TemporaryDirectory() as tmp:
-        return startup(startup_scenes(configs_dir, Path(tmp)), Path(tmp), quick)
+        return startup(startup_scenes(configs_dir, Path(tmp), quick), Path(tmp), quick)
 
 
 def main(out_dir: Path, configs_dir: Path, bare_walk: Path | None, quick: bool = False,

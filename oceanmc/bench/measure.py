@@ -12,8 +12,10 @@ from pathlib import Path
 from typing import Callable
 
 from ..config import load_config
+from ..kernel.variants import EVERYTHING
 from ..run.hdf5 import load_result
 from ..run.simulation import simulate
+from ..scene import predicted_variant
 from .scenes import FEATURES, QUICK_COLD_START, Quantity, with_photons
 
 # batches per error-vs-time run: the batch standard error, and so the FOM, to about 6% and 12%
@@ -102,6 +104,15 @@ def process_seconds(args: list, env: dict[str, str]) -> float:
     return seconds
 
 
+def whole_loop_seconds(env: dict[str, str]) -> float:
+    """Wall time of a fresh process that compiles the photon loop with every optional part
+    (run.compiling.ready's default), from its start to its exit."""
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-c", "from oceanmc.run.compiling import ready; ready()"],
+                   env=env, check=True, capture_output=True)
+    return time.perf_counter() - t0
+
+
 def run_seconds(config: Path, folder: Path, env: dict[str, str]) -> tuple[float, float]:
     """(process wall time, the result's startup_time_s) of `oceanmc run CONFIG --photons
     STARTUP_PHOTONS`."""
@@ -131,10 +142,15 @@ def startup(scenes: list[tuple[str, Path]], folder: Path, quick: bool) -> dict:
         first = run_seconds(config, folder, env)
         if cold:
             rows.append(target_row("cold start (empty cache)", label, *first, "process_s",
-                                   COLD_TARGET_S))
+                                   COLD_TARGET_S,
+                                   parts=predicted_variant(load_config(config)).label))
         rows.append(target_row("cached start", label, *run_seconds(config, folder, env),
                                "startup_time_s", CACHED_TARGET_S))
         envs.append(env)
+    if not quick:
+        rows.append(target_row("cold compilation of the whole loop (empty cache)", None,
+                               whole_loop_seconds(child_env(folder / "cache-whole")), None,
+                               "process_s", COLD_TARGET_S, parts=EVERYTHING.label))
     helps = [process_seconds(["--help"], child_env()) for _ in range(5)]
     rows.append(target_row("`oceanmc --help`, median of 5", None, statistics.median(helps), None,
                            "process_s", HELP_TARGET_S, runs=helps))

@@ -1,10 +1,18 @@
 """The compiled kernel, ready to run: its entry points compiled, or loaded from the disk cache.
 
-Every scene has the same argument types (records of fixed dtypes, flat pools), so each entry
-point has one signature, known before any scene is packed, and is compiled once per kernel
-version and machine. ready() compiles them in a helper thread (LLVM releases the GIL) so that
-the main thread can say what is happening every few seconds on stderr and stop at once on
-Ctrl-C (KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
+Every scene has the same argument types (records of fixed dtypes, flat pools) but for the
+with_<part> arguments, which say which optional parts of the photon loop a variant of it holds
+(kernel/variants.py): the entry points of a variant have one signature, known before any scene
+is packed, and are compiled once per kernel version, variant and machine, when a scene first
+needs that variant and no variant holding its parts is at hand (held_variant). The whole loop,
+every part compiled in, took 64-73 s to compile cold here (ready(), 2 cores, 2026-11-27, a
+machine about twice as slow as the one of the figures below); trace_batch's own LLVM work
+alone was 34 s of a one-process compilation of 106 s (optimisation 19.6 s, machine code
+14.4 s; the callees' 17.8 s and 17.0 s, Numba's front end 37.6 s). With no optional part the
+same took 31 s (trace_batch 6.1 s). benchmarks/speed.md has each shipped config's cold start
+with its own variant. ready() compiles in a helper thread (LLVM releases the GIL) so that the
+main thread can say what is happening every few seconds on stderr and stop at once on Ctrl-C
+(KeyboardInterrupt) or when should_stop() says so (CompileInterrupted).
 
 Numba compiles one function at a time, so on a machine with two or more cores the photon loop's
 events are compiled in two processes that meet in the disk cache: a child process compiles the

@@ -93,6 +93,7 @@ def main(out_dir: Path = Path("validation"), quick: bool = False, *,
          cases: list[str] | None = None, override: dict | None = None,
          threads: int | None = None) -> int:
     """Runs the validation cases and writes the report; returns 0 if every check passed, else 1."""
+    from ..run.compiling import ready
     from .report import write_report, write_results
 
     out_dir = Path(out_dir)
@@ -109,6 +110,10 @@ def main(out_dir: Path = Path("validation"), quick: bool = False, *,
             old.unlink()
 
     t0 = time.perf_counter()
+    # the cases' scenes hold every optional part of the photon loop between them: one
+    # compilation (or load) of the whole loop serves them all, where a variant per set of parts
+    # would be compiled one after another (kernel/variants.py)
+    ready()
     outcomes = []
     for case in selected:
         outcome = run_case(case.name, quick=quick, override=override, fig_dir=fig_dir,
