@@ -335,6 +335,13 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from . import bench
+    from .run.compiling import OWN_VARIANT_ENV
+
+    if not args.quick:
+        # each scene on the photon loop's variant with its own parts, whatever the cache holds
+        # (run/compiling.py); the quick smoke test takes what is at hand instead of compiling
+        # a variant per scene
+        os.environ[OWN_VARIANT_ENV] = "1"
 
     if args.spectral:
         from .bench import spectral

@@ -71,3 +71,16 @@ def test_a_scene_on_its_own_variant_gives_the_same_file_as_on_the_whole_loop(tmp
         assert len(names) > 50
         for name in names:
             assert np.array_equal(a[name][()], b[name][()], equal_nan=True), name
+
+
+def test_own_variant_setting_admits_only_the_scenes_own(monkeypatch):
+    """OCEANMC_OWN_VARIANT=1 (the bench's): a scene runs on its own variant only, never on a
+    larger one that the process or the cache holds."""
+    from oceanmc.run import compiling
+    spectral = Variant(*(False,) * len(PARTS))._replace(spectral=True)
+    monkeypatch.delenv(compiling.OWN_VARIANT_ENV, raising=False)
+    assert compiling._candidates(spectral) == spectral.supersets()
+    assert compiling._here(spectral) == EVERYTHING   # the session's whole loop
+    monkeypatch.setenv(compiling.OWN_VARIANT_ENV, "1")
+    assert compiling._candidates(spectral) == [spectral]
+    assert compiling._here(spectral) is None

@@ -203,19 +203,33 @@ def _loaded(variant: Variant) -> bool:
     return True
 
 
+# OCEANMC_OWN_VARIANT=1: every scene runs on the variant with exactly its own parts, compiled
+# where no process or cache holds it, never on a larger one, which saves the compilation but
+# runs slower (measured: the own variant traced the bare-walk scene 16% and configs/default.yaml
+# 14% faster than the whole loop, bit for bit the same tallies; 1 thread, medians of 7
+# interleaved runs, 2026-11-27). The bench sets it, so that its speeds do not depend on what
+# the cache holds.
+OWN_VARIANT_ENV = "OCEANMC_OWN_VARIANT"
+
+
+def _candidates(variant: Variant) -> list[Variant]:
+    """The variants a scene using `variant`'s parts may run on, the nearest first."""
+    return [variant] if os.environ.get(OWN_VARIANT_ENV) == "1" else variant.supersets()
+
+
 def held_variant(variant: Variant) -> Variant | None:
     """The variant of trace_batch, in this process or in the disk cache, that holds every part
     of `variant`: the nearest (Variant.supersets) of those here, else of those on disk (then
     loaded); None when there is none. A scene runs on any variant that holds its parts, with
     the same results bit for bit (kernel/variants.py), and compiles its own only when none is
-    at hand."""
-    return _here(variant) or next((candidate for candidate in variant.supersets()
+    at hand (or, under OCEANMC_OWN_VARIANT=1, when its own is not)."""
+    return _here(variant) or next((candidate for candidate in _candidates(variant)
                                    if _loaded(candidate)), None)
 
 
 def _here(variant: Variant) -> Variant | None:
     """The nearest variant holding `variant` that this process has compiled or loaded."""
-    return next((candidate for candidate in variant.supersets()
+    return next((candidate for candidate in _candidates(variant)
                  if _entry_signature(candidate) in trace_batch.overloads), None)
 
 
