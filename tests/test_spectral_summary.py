@@ -162,3 +162,21 @@ def test_monochromatic_summary_names_estimators_and_local_directions(small_scene
     labels = [line[2:30].strip()
               for line in format_summary(oceanmc.simulate(small_scene)).splitlines()]
     assert "Rrs nadir (crossing)" in labels and "Lu(1 m) (crossing)" in labels
+
+
+def test_a_run_at_one_wavelength_says_which():
+    """A file of one wavelength has no wavelength coordinate: the summary names it, and says
+    nothing of the kind for a monochromatic scene or a spectrum."""
+    from oceanmc.run.summary import single_wavelength
+    one = oceanmc.simulate(dict(SPECTRAL, wavelengths_nm=[550], photons=400), threads=1)
+    assert single_wavelength(one) == 550.0
+    assert "  at 550 nm (the scene's one wavelength)" in format_summary(one).splitlines()
+    ranged = oceanmc.simulate(dict(SPECTRAL, photons=400,
+                                   wavelengths_nm={"start": 555, "stop": 555, "step": 10}),
+                              threads=1)
+    assert single_wavelength(ranged) == 555.0
+    mono = dict(SPECTRAL, photons=400, illumination={"Ed0": 1.0, "sun_zenith_deg": 30},
+                water={"layers": [{"thickness_m": 5.0, "a": 0.1, "b": 0.2,
+                                   "phase": {"model": "isotropic"}}]})
+    del mono["wavelengths_nm"]
+    assert single_wavelength(oceanmc.simulate(mono, threads=1)) is None

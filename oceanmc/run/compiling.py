@@ -204,11 +204,11 @@ def _loaded(variant: Variant) -> bool:
 
 
 # OCEANMC_OWN_VARIANT=1: every scene runs on the variant with exactly its own parts, compiled
-# where no process or cache holds it, never on a larger one, which saves the compilation but
-# runs slower (measured: the own variant traced the bare-walk scene 16% and configs/default.yaml
-# 14% faster than the whole loop, bit for bit the same tallies; 1 thread, medians of 7
-# interleaved runs, 2026-11-27). The bench sets it, so that its speeds do not depend on what
-# the cache holds.
+# where no process or cache holds it, never on a larger one. A larger one saves a compilation
+# but runs slower: the own variant traced the bare-walk scene 16%, configs/default.yaml 14%,
+# and the bench's exact-nadir, nadir-cap and rough-sea scenes 7%, 6% and 10% faster than the
+# whole loop, with the same tallies bit for bit (1 thread, medians of 7 interleaved runs,
+# 2026-11-27). The bench sets it, so that its speeds do not depend on what the cache holds.
 OWN_VARIANT_ENV = "OCEANMC_OWN_VARIANT"
 
 

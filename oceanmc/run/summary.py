@@ -363,6 +363,23 @@ def completeness_line(result: Result) -> str | None:
     return head
 
 
+def single_wavelength(result: Result) -> float | None:
+    """The wavelength (nm) of a run that traced one, which its file holds no wavelength
+    coordinate for; None for a monochromatic scene (no wavelength) or several."""
+    import yaml
+    from pydantic import TypeAdapter
+
+    from ..config.wavelengths import Wavelengths, grid
+    try:
+        value = yaml.safe_load(result.config_yaml).get("wavelengths_nm")
+        wavelengths = grid(None if value is None
+                           else TypeAdapter(Wavelengths).validate_python(value))
+    except (AttributeError, KeyError, TypeError, ValueError, yaml.YAMLError):
+        return None
+    return float(wavelengths[0]) if len(wavelengths) == 1 and np.isfinite(wavelengths[0]) \
+        else None
+
+
 def format_summary(result: Result) -> str:
     a = result.attrs
     lines = [
@@ -371,6 +388,9 @@ def format_summary(result: Result) -> str:
         f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
         f"(start-up {a['startup_time_s']:.2f} s)",
     ]
+    at = single_wavelength(result)
+    if at is not None:
+        lines.append(f"  at {at:g} nm (the scene's one wavelength)")
     said = completeness_line(result)
     if said is not None:
         lines.append(said)
