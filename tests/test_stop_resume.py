@@ -275,3 +275,19 @@ def test_partial_summary_says_how_many_batches_and_that_few_give_unreliable_erro
     main(["show", str(full.save(tmp_path / "whole.h5"))])
     out = capsys.readouterr().out
     assert "PARTIAL" not in out and "unreliable" not in out
+
+
+@pytest.mark.parametrize("junk, said", [
+    ({}, "lack batch, rng, beam, next_photon, events"),
+    ({"batch": [0], "rng": np.zeros((1, 4), dtype=np.uint64), "beam": np.zeros((1, 4))},
+     "lack next_photon, events"),
+    ({"batch": [0, 1], "rng": np.zeros((1, 4), dtype=np.uint64), "beam": np.zeros((2, 4)),
+      "next_photon": [5, 5], "events": [0, 0]}, "rng do not hold one row for each of their 2"),
+    ({"batch": [0], "rng": np.zeros((1, 99), dtype=np.uint64), "beam": np.zeros((1, 4)),
+      "next_photon": [5], "events": [0]}, "rng do not hold one row"),
+])
+def test_a_resume_state_that_is_not_a_partial_results_is_refused(small_scene, junk, said):
+    """simulate(resume_state=...) of something else than a partial Result's resume_state: one
+    line saying what it lacks (was a KeyError 'batch'), before any photon is traced."""
+    with pytest.raises(MergeError, match=said):
+        oceanmc.simulate(small_scene, resume_state=junk)

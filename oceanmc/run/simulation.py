@@ -41,6 +41,8 @@ LINE_FLOATS = 8                           # a 64-byte cache line of float64
 PACKET_STRIDE = 256 // PACKET.itemsize    # packets of two batches 256 bytes apart
 RNG_STRIDE = 16                           # random states 128 bytes apart (written at every draw)
 RNG_WORDS = 2 * STATE_WORDS               # a batch's two streams (kernel/rng.py batch_state)
+# what Batches.unfinished stores of each unfinished batch, beside its tally arrays (tally/...)
+RESUME_STATE_KEYS = ("batch", "rng", "beam", "next_photon", "events")
 CALL_SECONDS = 0.2      # aimed length of one kernel call: the latency of a stop or a checkpoint
 FIRST_BUDGET = 1 << 12  # work units (photons + scattering events) of a batch's first call
 MIN_BUDGET = 1 << 8
@@ -234,8 +236,20 @@ class Batches:
         """Puts a partial run's unfinished batches (Result.resume_state) back where they
         stopped, their tally rows rebuilt from the named score arrays. Raises MergeError (one
         line: the CLI's --resume says it and exits 2) when those arrays or batches are not this
-        scene's."""
-        rows = np.zeros((len(state["batch"]), self.tallies.shape[1]))
+        scene's, or the state is not a partial Result's."""
+        missing = [key for key in RESUME_STATE_KEYS if key not in state]
+        if missing:
+            raise MergeError(f"the stored unfinished batches lack {', '.join(missing)}: "
+                             "allowed a partial Result's resume_state")
+        count = len(np.atleast_1d(state["batch"]))
+        uneven = [key for key in RESUME_STATE_KEYS if np.ndim(state[key]) < 1
+                  or len(state[key]) != count
+                  or (key == "rng" and not 0 < np.shape(state[key])[-1] <= RNG_WORDS)]
+        if uneven:
+            raise MergeError(f"the stored unfinished batches' {', '.join(uneven)} do not hold "
+                             f"one row for each of their {count} batches: allowed a partial "
+                             "Result's resume_state")
+        rows = np.zeros((count, self.tallies.shape[1]))
         try:
             write_tally_arrays(self.grid, {key.removeprefix("tally/"): values
                                            for key, values in state.items()
