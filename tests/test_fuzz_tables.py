@@ -392,3 +392,25 @@ def test_text_or_complex_arrays_in_brdf_tables_and_sky_maps_are_refused(tmp_path
     with warnings.catch_warnings():
         warnings.simplefilter("error")   # numpy's ComplexWarning on the way to float
         refused((brdf_table if kind == "brdf" else sky_map)(str(path)), path, words)
+
+
+@pytest.mark.parametrize("name", ["component table", "profile table", "spectrum table",
+                                  "bottom spectrum table"])
+def test_a_csv_of_other_separators_or_a_bad_row_is_named_in_one_line(tmp_path, name):
+    """A table written with semicolons (a spreadsheet's CSV in many locales) or tabs was read as
+    one column and refused as 'every row after the header must be 1 numbers'; a row with a
+    field that is not a number, or too few fields, is now named."""
+    header, rows, place = TEXT_TABLES[name]
+    path = tmp_path / "table.csv"
+    for sep, said in ((";", "separated by semicolons"), ("\t", "separated by tabs")):
+        path.write_text(_text(header, rows).replace(",", sep))
+        refused(place(str(path)), path, "is one column", said, "allowed: columns separated by "
+                "commas")
+    text = _text(header, rows).splitlines()
+    text[2] = text[2].replace(",", ",x", 1)
+    path.write_text("\n".join(text) + "\n")
+    refused(place(str(path)), path, f"row {text[2]!r}", "numbers separated by commas")
+    text = _text(header, rows).splitlines()
+    text[2] = text[2].rsplit(",", 1)[0]
+    path.write_text("\n".join(text) + "\n")
+    refused(place(str(path)), path, f"row {text[2]!r}", "every row must have")

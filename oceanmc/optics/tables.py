@@ -35,19 +35,37 @@ def _parsed_csv(path: str, mtime_ns: int, size: int, inode: int) -> dict[str, np
     if len(rows) < 2:
         raise ConfigError(f"{path}: needs a header line of column names and at least one row")
     names = [n.strip() for n in rows[0].split(",")]
+    other = next((name for sep, name in ((";", "semicolons"), ("\t", "tabs"))
+                  if len(names) == 1 and sep in rows[0]), None)
+    if other:
+        raise ConfigError(f"{path}: the header {rows[0].strip()!r} is one column: its columns "
+                          f"are separated by {other}; allowed: columns separated by commas")
     twice = [n for k, n in enumerate(names) if n in names[:k]]
     if twice:
         raise ConfigError(f"{path}: column {twice[0]!r} appears twice in the header; allowed: "
                           "each column once")
-    try:
-        data = np.array([[float(x) for x in row.split(",")] for row in rows[1:]])
-    except ValueError:
-        raise ConfigError(f"{path}: every row after the header must be {len(names)} numbers "
-                          "separated by commas") from None
-    if data.ndim != 2 or data.shape[1] != len(names):
-        raise ConfigError(f"{path}: every row must have {len(names)} values ({', '.join(names)})")
+    values = [_numbers(row) for row in rows[1:]]
+    bad = next((row for row, numbers in zip(rows[1:], values) if numbers is None), None)
+    if bad is not None:
+        raise ConfigError(f"{path}: row {bad.strip()!r}: every row after the header must be "
+                          f"{len(names)} number{'s' if len(names) > 1 else ''} separated by "
+                          "commas")
+    uneven = next((row for row, numbers in zip(rows[1:], values)
+                   if len(numbers) != len(names)), None)
+    if uneven is not None:
+        raise ConfigError(f"{path}: row {uneven.strip()!r}: every row must have {len(names)} "
+                          f"values ({', '.join(names)})")
+    data = np.array(values)
     data.flags.writeable = False   # the remembered table is shared by every reader
     return {name: data[:, k] for k, name in enumerate(names)}
+
+
+def _numbers(row: str) -> list[float] | None:
+    """The row's comma-separated numbers; None if a field is not a number."""
+    try:
+        return [float(x) for x in row.split(",")]
+    except ValueError:
+        return None
 
 
 @lru_cache(maxsize=None)
