@@ -80,6 +80,20 @@ def test_saving_over_an_existing_file_without_overwrite_is_refused_before_writin
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
 
 
+def test_saving_to_a_folder_is_refused_in_one_line(tmp_path, monkeypatch):
+    """Result.save(".") was pathlib's "has an empty name", save(folder) an IsADirectoryError
+    about a temporary file beside the folder."""
+    import oceanmc
+    from conftest import SMALL_SCENE
+    result = oceanmc.simulate(dict(SMALL_SCENE, photons=400), threads=1)
+    monkeypatch.chdir(tmp_path)
+    for folder in (".", tmp_path, "..", tmp_path / "sub" / ".."):
+        with pytest.raises(IsADirectoryError, match=r"is a folder: save\(\) takes the results "
+                           r"file's own path"):
+            result.save(folder)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("threads", [0, -3, "x", 1.5])
 def test_simulate_refuses_a_thread_count_that_is_not_a_positive_integer(threads):
     """simulate(threads=0) ran on 1 thread without a word, threads='x' gave int()'s error."""

@@ -72,7 +72,10 @@ class Result:
     def save(self, path: str | Path, overwrite: bool = True) -> Path:
         """Writes the results file (format.save_result); overwrite=False: never replace an
         existing file (placement.place_atomically), and refuse one that exists before writing
-        anything (FileExistsError)."""
+        anything (FileExistsError). A folder is refused (IsADirectoryError) before writing."""
+        if Path(path).is_dir() or Path(path).name in ("", ".", ".."):
+            raise IsADirectoryError(f"{path} is a folder: save() takes the results file's own "
+                                    "path, such as results/scene.h5")
         if not overwrite and Path(path).exists():
             raise FileExistsError(f"{path} exists; save(..., overwrite=True) replaces it")
         return save_result(self, path, overwrite)
