@@ -80,6 +80,22 @@ def test_saving_over_an_existing_file_without_overwrite_is_refused_before_writin
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
 
 
+def test_show_and_plot_of_a_sweep_dataset_say_how_to_open_it(tmp_path):
+    """A sweep's NetCDF dataset given to show or plot was 'no format_version attribute: not an
+    oceanmc results file', with no word of what it is or how to read it."""
+    import h5py
+    from oceanmc.run.format import SWEEP_TITLE
+    path = tmp_path / "lut.nc"
+    with h5py.File(path, "w") as f:
+        f.attrs["title"] = SWEEP_TITLE
+    for command in ("show", "plot"):
+        done = subprocess.run([sys.executable, "-m", "oceanmc", command, str(path)],
+                              env=ENV, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 2, done.stderr
+        assert "an oceanmc sweep dataset (NetCDF), not the results file of one run: open it " \
+            "with xarray.open_dataset" in done.stderr and done.stderr.count("\n") == 1
+
+
 def test_saving_to_a_folder_is_refused_in_one_line(tmp_path, monkeypatch):
     """Result.save(".") was pathlib's "has an empty name", save(folder) an IsADirectoryError
     about a temporary file beside the folder."""

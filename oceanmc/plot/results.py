@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config.loading import file_problem
+from ..run.format import SWEEP_DATASET_MESSAGE, SWEEP_TITLE
 from ..run.results import PART_LABELS, lowest_requested
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
@@ -68,6 +69,8 @@ def open_result(path: str | Path) -> ResultFile:
         raise PlotInputError(f"{path}: not an oceanmc results file (not readable as HDF5: "
                              f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
                              ) from None
+    if water.attrs.get("title") == SWEEP_TITLE:
+        raise PlotInputError(f"{path}: {SWEEP_DATASET_MESSAGE}")
     if "format_version" not in water.attrs or "Ed" not in water:
         raise PlotInputError(f"{path}: not an oceanmc results file (no format_version attribute "
                              "or no Ed)")

@@ -15,6 +15,12 @@ from .derived import write_derived
 from .placement import place_atomically
 
 FORMAT_VERSION = 1
+# the title attribute of a sweep's dataset (sweeps/dataset.py), and what show and plot say of
+# such a file
+SWEEP_TITLE = "oceanmc sweep"
+SWEEP_DATASET_MESSAGE = ("an oceanmc sweep dataset (NetCDF), not the results file of one "
+                         "run: open it with xarray.open_dataset (README, Sweeps); a point's own "
+                         "results file is in the sweep's points folder")
 
 COORD_UNITS = {"depth": ("m", "depth below the mean surface, positive down; 0 is 0- "
                                "(just below the surface)"),

@@ -12,7 +12,8 @@ import h5py
 import numpy as np
 import yaml
 
-from .format import COORD_UNITS, FORMAT_VERSION, RESUME_FIELDS, RESUME_GROUP
+from .format import (COORD_UNITS, FORMAT_VERSION, SWEEP_DATASET_MESSAGE, RESUME_FIELDS,
+                     RESUME_GROUP, SWEEP_TITLE)
 from .format import save_result  # noqa: F401  (the documented path: oceanmc.run.hdf5)
 from .result import Quantity, Result
 
@@ -30,6 +31,8 @@ def load_result(path: str | Path) -> Result:
     try:
         with h5py.File(path, "r") as f:
             version = _plain(f.attrs.get("format_version"))
+            if version is None and _plain(f.attrs.get("title")) == SWEEP_TITLE:
+                raise ResultsFileError(SWEEP_DATASET_MESSAGE)
             if version != FORMAT_VERSION:
                 raise ResultsFileError(
                     "no format_version attribute: not an oceanmc results file" if version is None

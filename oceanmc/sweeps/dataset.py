@@ -17,7 +17,7 @@ import numpy as np
 import yaml
 
 from .. import __version__
-from ..run.format import COORD_UNITS
+from ..run.format import COORD_UNITS, SWEEP_TITLE
 from ..run.hdf5 import load_result
 from ..run.merge import merge_results, scene_difference
 from ..run.placement import place_atomically
@@ -26,7 +26,6 @@ from .axes import SweepError, SweepSpec, coordinate, load_sweep
 from .points import Point
 
 DONE, FAILED, PENDING = "done", "failed", "pending"
-TITLE = "oceanmc sweep"
 
 
 class OutputExists(Exception):
@@ -170,7 +169,7 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     data["wall_time_s"] = (dims, wall, {"units": "s", "description": "run time of the point"})
     counts = {s: int((status == s).sum()) for s in (DONE, FAILED, PENDING)}
     attrs = {
-        "title": TITLE,
+        "title": SWEEP_TITLE,
         "oceanmc_version": __version__,
         "base_scene_yaml": yaml.safe_dump(spec.base, sort_keys=False),
         "sweep_yaml": spec.to_yaml(),
@@ -221,7 +220,7 @@ def check_replaceable(path: Path, folder: Path, spec: SweepSpec) -> None:
                            f"; {how}") from None
     text = {key: value.decode() if isinstance(value, bytes) else value
             for key, value in attrs.items()}
-    if text["title"] != TITLE:
+    if text["title"] != SWEEP_TITLE:
         raise OutputExists(f"{path} exists and is not an oceanmc sweep dataset; {how}")
     try:
         stored = yaml.safe_load(text["sweep_yaml"])
