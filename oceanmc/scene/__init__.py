@@ -63,8 +63,10 @@ class Scene:
         """The optional parts of the photon loop that this scene's records may run
         (kernel/variants.py): trace it only on a variant that holds them."""
         g, est = self.grid[0], self.estimates[0]
-        return Variant(spectral=bool(g["n_wl"] > 1),
-                       inelastic=bool(self.medium[0]["n_channels"] > 1 or g["n_parts"] > 1),
+        inelastic = bool(self.medium[0]["n_channels"] > 1 or g["n_parts"] > 1)
+        # (the kernel settles inelastic light through the spectral walk's functions: a scene
+        # with inelastic light uses both parts, whatever its number of wavelengths)
+        return Variant(spectral=bool(g["n_wl"] > 1) or inelastic, inelastic=inelastic,
                        rough_surface=not self.surface[0]["delta"],
                        reflecting_bottom=bool(self.bottom[0]["reflects"]),
                        local_estimates=bool(est["directions_on"] or est["cap_on"]))
@@ -75,9 +77,9 @@ def predicted_variant(config: cfg.SceneConfig) -> Variant:
     the loop is compiled before (or while) the scenes are packed. Only a prediction: the run
     checks it against the packed scene's own (Scene.variant), and a part it missed costs a
     second compilation, never a wrong result."""
-    inelastic = config.water.inelastic
-    return Variant(spectral=len(config.wavelengths) > 1,
-                   inelastic=inelastic is not None and bool(inelastic.processes()),
+    asked = config.water.inelastic
+    inelastic = asked is not None and bool(asked.processes())
+    return Variant(spectral=len(config.wavelengths) > 1 or inelastic, inelastic=inelastic,
                    rough_surface=not surface.pack(config.surface, config.n_water)[0]["delta"],
                    reflecting_bottom=config.bottom.model not in ("none", "black"),
                    local_estimates=bool(config.tallies.local_directions_deg)
