@@ -142,7 +142,7 @@ def test_channel_registry_and_dispatch():
         p = packet[0]
         p.w, p.ux, p.uy, p.uz = 1.0, 0.0, 0.0, 1.0
         channels.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, False,
-                         rng)
+                         rng, True)   # (with_spectral: compiled in; kernel/variants.py)
         return p.w, p.uz
 
     sc = scene.build(oceanmc.load_config({
@@ -163,8 +163,9 @@ def test_channel_registry_and_dispatch():
         p.w, p.ux, p.uy, p.uz, p.z, p.seg = 1.0, 0.0, 0.0, 1.0, 0.5, 0
         spectral.collision_density(medium[0], floats, grid[0], ps, p, 0,
                                    work[:grid[0].n_wl])
+        # (with_rough_surface, with_local_estimates: compiled in; kernel/variants.py)
         return channels.emit(medium[0], surface[0], ctrl[0], grid[0], est[0], floats, ints,
-                             tally, work, stack, stack_ps, 0, p, ps, 0, False, rng)
+                             tally, work, stack, stack_ps, 0, p, ps, 0, False, rng, True, True)
 
     inelastic = {"raman": {"b488_per_m": 0.05}, "chlorophyll_fluorescence": {}}
     sc = scene.build(oceanmc.load_config({

@@ -46,7 +46,8 @@ def _scatter(sc, n, rng, ux, uy, uz):
     up = np.empty(n)
     for i in range(n):
         p.w, p.ux, p.uy, p.uz = 1.0, ux, uy, uz
-        elastic.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, False, rng)
+        elastic.scatter(medium[0], mf, mi, ctrl[0], grid[0], tally, ps, work, p, 0, False, rng,
+                        True)   # (with_spectral: compiled in, the records decide)
         weights[i] = p.w
         up[i] = -p.uz
     return weights, up
