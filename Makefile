@@ -18,7 +18,7 @@ run: $(STAMP)
 	$(BIN)/oceanmc run configs/default.yaml -o results/default.h5 --overwrite
 
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto
 
 validate: $(STAMP)
 	$(BIN)/oceanmc validate -o validation

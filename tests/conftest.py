@@ -1,4 +1,5 @@
 import copy
+import os
 from pathlib import Path
 
 import pytest
@@ -34,3 +35,20 @@ def whole_photon_loop():
     variant of its own. tests/test_variants.py runs scenes on their own variants."""
     from oceanmc.run.compiling import ready
     ready()
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    """`make test` runs the tests in parallel processes (pytest-xdist, -n auto): one per core
+    this process may use, at most 8 (each holds its own compiled photon loop)."""
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return max(1, min(usable or 1, 8))
+
+
+def pytest_configure(config):
+    """With parallel workers (pytest-xdist), the controlling process compiles the whole photon
+    loop into the disk cache before it starts them, so that each worker loads it (about a
+    second) instead of all compiling it at once."""
+    if not hasattr(config, "workerinput") and config.getoption("numprocesses", default=None):
+        from oceanmc.run.compiling import ready
+        ready()
