@@ -8,6 +8,7 @@ import math
 import numba
 import numpy as np
 import pytest
+import yaml
 from scipy import integrate, special
 
 import oceanmc
@@ -172,6 +173,7 @@ def test_reflection_and_transmission_are_reciprocal(from_air):
      "surface.wind_direction_deg = 30.0 needs surface.wind_speed_m_s"),
     ({"model": "cox_munk"}, "exactly one of wind_speed_m_s"),
     ({"model": "flat", "wind_speed_m_s": 5}, "belong to surface.model = 'cox_munk'"),
+    ({"model": "none", "n_water": 1.34}, "surface.n_water = 1.34 with surface.model = 'none'"),
 ])
 def test_bad_surface_input_is_one_line(surface, message):
     with pytest.raises(ConfigError) as err:
@@ -179,6 +181,20 @@ def test_bad_surface_input_is_one_line(surface, message):
             {"thickness_m": 1.0, "a": 0.1, "b": 0.1}]}, "bottom": {"model": "black"}})
     text = str(err.value)
     assert message in text and "\n" not in text
+
+
+def test_no_interface_stores_the_index_it_uses():
+    """surface.model none runs with n_water 1 (index-matched): the stored config says so and
+    loads back as the same scene, and an index of 1 may be written."""
+    from oceanmc.config.loading import config_to_yaml
+    water = {"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 0.1}]}
+    scene = oceanmc.load_config({"surface": {"model": "none"}, "water": water,
+                                 "bottom": {"model": "black"}})
+    assert scene.surface.n_water == 1.0 and scene.n_water == 1.0
+    again = oceanmc.load_config(yaml.safe_load(config_to_yaml(scene)))
+    assert again.surface == scene.surface
+    assert oceanmc.load_config({"surface": {"model": "none", "n_water": 1}, "water": water,
+                                "bottom": {"model": "black"}}).n_water == 1.0
 
 
 def test_wind_speed_gives_cox_munk_variances():

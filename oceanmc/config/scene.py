@@ -203,4 +203,4 @@ class SceneConfig(_Strict):
 
     @property
     def n_water(self) -> float:
-        return self.surface.n_water if self.surface.model != "none" else 1.0
+        return self.surface.n_water   # (1 with surface.model none: config/surface.py)
