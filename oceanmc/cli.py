@@ -109,8 +109,8 @@ def _ready_or_exit(scene_files: list[Path], configs: list) -> None:
     stop.install()
     try:
         ready(union(map(predicted_variant, configs)), lambda: stop.requested, scene_files)
-    except CompileInterrupted:
-        print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; "
+    except CompileInterrupted as exc:
+        print(f"oceanmc: stopped by {stop.signal_name} {exc}; "
               "nothing was traced and no file was written", file=sys.stderr, flush=True)
         sys.stdout.flush()
         os._exit(130)
@@ -300,9 +300,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     except SweepError as exc:
         print(f"oceanmc: config error: {exc}", file=sys.stderr)
         return 2
-    except CompileInterrupted:
+    except CompileInterrupted as exc:
         # the compilation goes on in its own thread inside LLVM; leave at once (as cmd_run)
-        print(f"oceanmc: stopped by {stop.signal_name} while compiling the photon loop; no "
+        print(f"oceanmc: stopped by {stop.signal_name} {exc}; no "
               "point ran and no dataset was written", file=sys.stderr, flush=True)
         sys.stdout.flush()
         os._exit(130)

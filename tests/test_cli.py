@@ -206,6 +206,18 @@ def test_kernel_runs_without_jit(tmp_path, scene_file):
     assert "budget total" in done.stdout
 
 
+def test_a_stop_while_the_loop_loads_from_the_cache_says_loading():
+    """A stop asked while the photon loop is loaded from the disk cache (some tenths of a
+    second; the stop is polled every 0.1 s) names the loading, not a compilation (the tests'
+    session has put the whole loop in the cache: conftest.whole_photon_loop)."""
+    code = ("from oceanmc.run.compiling import CompileInterrupted, ready\n"
+            "try:\n    ready(should_stop=lambda: True)\n"
+            "except CompileInterrupted as exc:\n    print(exc)\n")
+    done = subprocess.run([sys.executable, "-c", code], env=ENV, capture_output=True,
+                          text=True, timeout=300)
+    assert done.stdout.strip() == "while loading the photon loop from the disk cache", done
+
+
 def test_ctrl_c_while_compiling_stops_at_once_without_a_file(tmp_path, scene_file):
     """With an empty compile cache the run says that it is compiling (what and why); Ctrl-C
     then ends it within a second, with exit status 130, a clear message and no results file."""

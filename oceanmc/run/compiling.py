@@ -84,6 +84,7 @@ trace_batch per feature set, compiled when a scene first needs it).
 """
 from __future__ import annotations
 
+import functools
 import inspect
 import os
 import subprocess
@@ -114,7 +115,8 @@ CHILD_TIMEOUT_S = 600.0
 
 
 class CompileInterrupted(Exception):
-    """The user asked to stop while the kernel was compiling; nothing was traced."""
+    """The user asked to stop while the kernel was compiling or loading from the disk cache
+    (the text says which: "while compiling the photon loop"); nothing was traced."""
 
 
 def _argument_types(variant: Variant) -> dict[str, numba.types.Type]:
@@ -152,15 +154,17 @@ def _signature(function, types: dict[str, numba.types.Type]) -> tuple:
     return tuple(types[name] for name in inspect.signature(function.py_func).parameters)
 
 
-def parts(variant: Variant) -> dict[str, list[tuple]]:
+@functools.cache
+def parts(variant: Variant) -> dict[str, tuple[tuple, ...]]:
     """(dispatcher, argument types) to compile, in order: `events` (in the child process when
     there is one: the walk's events but the collision, and trace_batch's other callees),
     `collision` and `entry` (the entry points, trace_batch first) here. A function compiled in
     `events` with other argument types than trace_batch calls it with would only be compiled
-    again here, at no other cost (checked once: none is)."""
+    again here, at no other cost (checked once: none is). Cached: ready() asks for every
+    candidate variant's on each call, and the signatures come from inspect."""
     types = _argument_types(variant)
     spectral_start = (spectral.start,) if variant.spectral else ()
-    return {name: [(f, _signature(f, types)) for f in functions] for name, functions in (
+    return {name: tuple((f, _signature(f, types)) for f in functions) for name, functions in (
         ("events", (transport.enter_from_air, transport.leave_or_reflect,
                     transport.reflect_at_bottom, transport.free_flight, transport.cross_plane,
                     transport.after_reflection, transport.split_into, sources.sky_direction,
@@ -336,7 +340,8 @@ def ready(variant: Variant = EVERYTHING, should_stop: Callable[[], bool] | None 
             while worker.is_alive():
                 worker.join(0.1)
                 if should_stop is not None and should_stop():
-                    raise CompileInterrupted("stopped while compiling the photon loop")
+                    raise CompileInterrupted("while compiling the photon loop" if cold else
+                                             "while loading the photon loop from the disk cache")
                 elapsed = time.perf_counter() - t0
                 if worker.is_alive() and elapsed >= COMPILE_NOTICE_AFTER_S \
                         and elapsed - said >= 5.0:
