@@ -60,7 +60,7 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               emission's phase function (1 + beta cos^2), 0 isotropic), channel_sigma
 #               ((n_channels - 1) x n_layers x n_wl: what each takes per unit weight and
 #               length), channel_reach ((n_channels - 1) x n_wl: the row sums of its
-#               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, emission-major: T_ji at [i, j])
+#               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, excitation-major)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
@@ -68,9 +68,9 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               mix_comp, mix_at: the terms of each layer's volume scattering functions, all
 #               wavelengths side by side (scene/medium.py scattering_terms, kernel/spectral.py);
 #               channel_model (n_channels: registry.CHANNEL ids; channel 0 is elastic);
-#               channel_band ((n_channels - 1) x n_wl x 2: for each emission wavelength,
-#               the excitation wavelengths first .. last - 1 that emit into it),
-#               channel_emits ((n_channels - 1) x 2: the wavelengths anything emits into)
+#               channel_band ((n_channels - 1) x n_wl x 2: each excitation row's emission
+#               columns first .. last - 1), channel_emits ((n_channels - 1) x 2: the columns
+#               any row emits into)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),

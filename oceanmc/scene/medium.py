@@ -318,8 +318,8 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         channel_beta=f.add([0.0] + [ch.phase_beta for ch in inelastic]),
         channel_sigma=f.add([ch.sigma for ch in inelastic]),
         channel_reach=f.add([ch.transfer.sum(axis=1) for ch in inelastic]),
-        channel_transfer=f.add([ch.transfer.T for ch in inelastic]),   # emission-major
-        channel_band=i.add([optics.inelastic.band(ch.transfer.T) for ch in inelastic]),
+        channel_transfer=f.add([ch.transfer for ch in inelastic]),
+        channel_band=i.add([optics.inelastic.band(ch.transfer) for ch in inelastic]),
         channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers), windows,
                     weight_window.segment_windows(windows, layers, plane_z), upward)

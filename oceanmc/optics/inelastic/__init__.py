@@ -91,9 +91,8 @@ def transfer(process, settings, wavelengths_nm: np.ndarray, sigma_shape: np.ndar
 
 
 def band(transfer: np.ndarray) -> np.ndarray:
-    """(rows, 2): each row's first column with light and the one after its last (0, 0 for a
-    row without any); of the transposed transfer, each emission wavelength's excitation
-    wavelengths (kernel/channels/inelastic.py)."""
+    """(n_wl, 2): each excitation row's first emission column with light and the one after
+    its last (0, 0 for a row that emits nothing)."""
     out = np.zeros((transfer.shape[0], 2), dtype=np.int64)
     for j, row in enumerate(transfer):
         lit = np.nonzero(row > 0.0)[0]
