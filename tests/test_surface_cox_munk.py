@@ -173,7 +173,6 @@ def test_reflection_and_transmission_are_reciprocal(from_air):
      "surface.wind_direction_deg = 30.0 needs surface.wind_speed_m_s"),
     ({"model": "cox_munk"}, "exactly one of wind_speed_m_s"),
     ({"model": "flat", "wind_speed_m_s": 5}, "belong to surface.model = 'cox_munk'"),
-    ({"model": "none", "n_water": 1.34}, "surface.n_water = 1.34 with surface.model = 'none'"),
 ])
 def test_bad_surface_input_is_one_line(surface, message):
     with pytest.raises(ConfigError) as err:
@@ -183,18 +182,19 @@ def test_bad_surface_input_is_one_line(surface, message):
     assert message in text and "\n" not in text
 
 
-def test_no_interface_stores_the_index_it_uses():
-    """surface.model none runs with n_water 1 (index-matched): the stored config says so and
-    loads back as the same scene, and an index of 1 may be written."""
+@pytest.mark.parametrize("given", [{}, {"n_water": 1.0}, {"n_water": 1.34}])
+def test_no_interface_stores_the_index_it_uses(given):
+    """surface.model none runs with n_water 1 (index-matched) whatever n_water says (a sweep
+    over surface.model keeps the scene's n_water for its other models): the stored config
+    says 1 and loads back as the same scene."""
     from oceanmc.config.loading import config_to_yaml
     water = {"layers": [{"thickness_m": 1.0, "a": 0.1, "b": 0.1}]}
-    scene = oceanmc.load_config({"surface": {"model": "none"}, "water": water,
+    scene = oceanmc.load_config({"surface": {"model": "none", **given}, "water": water,
                                  "bottom": {"model": "black"}})
     assert scene.surface.n_water == 1.0 and scene.n_water == 1.0
+    assert "n_water: 1.0\n" in config_to_yaml(scene)
     again = oceanmc.load_config(yaml.safe_load(config_to_yaml(scene)))
     assert again.surface == scene.surface
-    assert oceanmc.load_config({"surface": {"model": "none", "n_water": 1}, "water": water,
-                                "bottom": {"model": "black"}}).n_water == 1.0
 
 
 def test_wind_speed_gives_cox_munk_variances():

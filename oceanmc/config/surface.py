@@ -44,13 +44,9 @@ class Surface(_Strict):
     @model_validator(mode="after")
     def _slopes_given_once(self) -> "Surface":
         if self.model == "none":
-            # no interface: the water's index is 1 (index-matched), which the stored config
-            # then says (it loads back as the same scene)
-            if "n_water" in self.model_fields_set and self.n_water != 1.0:
-                raise ValueError(f"surface.n_water = {self.n_water} with surface.model = "
-                                 "'none': without an interface the water's refractive index "
-                                 "is 1 (index-matched); drop n_water, or use model 'flat' or "
-                                 "'cox_munk' for an air-water interface")
+            # no interface: the water's index is 1 (index-matched) whatever n_water says, and
+            # the stored config says 1. Not refused: a sweep over surface.model, or an
+            # override of a scene's model, keeps the scene's n_water for its other models
             self.n_water = 1.0
         rough = (self.wind_speed_m_s, self.mean_square_slope, self.wind_direction_deg,
                  self.method)
