@@ -138,11 +138,13 @@ def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
 @pytest.mark.parametrize("change, message", [
     (lambda s: s.update(photons=True), "config: photons = True: expected a number"),
     (lambda s: s["water"]["layers"][0].update(a=True),
-     "config: water.layers[0]: a = True: expected a number"),
+     "config: water.layers[0]: a = True: expected a number or a list"),
     (lambda s: s["bottom"].update(reflectance=False),
-     "config: bottom: reflectance = False: expected a number"),
+     "config: bottom: reflectance = False: expected a number, a list or a mapping"),
     (lambda s: s["illumination"].update(sun_zenith_deg=True),
      "config: illumination: sun_zenith_deg = True: expected a number"),
+    (lambda s: s["water"].update(inelastic=True),
+     "config: water: inelastic = True: expected a mapping"),
 ])
 def test_a_boolean_for_a_number_is_refused(small_scene, change, message):
     """pydantic reads True as 1 and YAML reads yes/no/on/off as booleans: `a: yes` ran with
@@ -150,6 +152,23 @@ def test_a_boolean_for_a_number_is_refused(small_scene, change, message):
     change(small_scene)
     assert _error(small_scene).startswith(message + " (YAML reads true, false, yes, no, on "
                                           "and off as booleans)")
+
+
+def test_a_blank_inelastic_process_is_refused_and_the_stored_config_leaves_out_those_off(
+        small_scene):
+    """`raman:` with nothing after it is YAML's null, which turned Raman scattering off (exit
+    status 0) where the user asked for it: refused in one line. The stored config leaves out
+    the processes that are off instead of writing them as null, and loads back the same."""
+    small_scene["wavelengths_nm"] = [500.0, 550.0]
+    small_scene["water"]["inelastic"] = {"raman": None, "chlorophyll_fluorescence": {}}
+    assert _error(small_scene) == (
+        "config: water.inelastic: raman = null (nothing after 'raman:'): give {} for its "
+        "published defaults, or leave the key out to turn it off")
+    small_scene["water"]["inelastic"] = {"chlorophyll_fluorescence": {}}
+    config = load_config(small_scene)
+    text = config_to_yaml(config)
+    assert "raman" not in text and "cdom_fluorescence" not in text
+    assert load_config(yaml.safe_load(text)).water.inelastic == config.water.inelastic
 
 
 def test_booleans_stay_allowed_where_they_mean_something(small_scene):

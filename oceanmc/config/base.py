@@ -23,6 +23,22 @@ def _admits_boolean(annotation: Any) -> bool:
     return annotation in (bool, Any) or origin is typing.Literal
 
 
+def _expected(annotation: Any) -> str:
+    """What a field takes, in words, for a message: a mapping (a group of keys), a list, or a
+    number."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _expected(typing.get_args(annotation)[0])
+    if origin in (typing.Union, types.UnionType):
+        given = " ".join(_expected(a) for a in typing.get_args(annotation)
+                         if a is not type(None))
+        kinds = [k for k in ("a number", "a list", "a mapping") if k in given]
+        return " or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return "a mapping"
+    return "a list" if origin in (list, tuple) else "a number"
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_default=True)
 
@@ -37,8 +53,9 @@ class _Strict(BaseModel):
                 field = cls.model_fields.get(name) if isinstance(name, str) else None
                 if isinstance(value, bool) and field is not None \
                         and not _admits_boolean(field.annotation):
-                    raise ValueError(f"{name} = {value}: expected a number (YAML reads true, "
-                                     "false, yes, no, on and off as booleans)")
+                    raise ValueError(f"{name} = {value}: expected "
+                                     f"{_expected(field.annotation)} (YAML reads true, false, "
+                                     "yes, no, on and off as booleans)")
         return data
 
 

@@ -14,7 +14,7 @@ import math
 from typing import Annotated, Optional
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, model_serializer, model_validator
 
 from .base import _Strict
 
@@ -116,6 +116,24 @@ class Inelastic(_Strict):
     chlorophyll_fluorescence: Optional[ChlorophyllFluorescence] = None
     cdom_fluorescence: Optional[CdomFluorescence] = None
     max_step_nm: Annotated[float, Field(ge=0.5, le=50.0, allow_inf_nan=False)] = 10.0
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_blank_process(cls, data):
+        # `raman:` with nothing after it is YAML's null, which would turn Raman scattering off
+        # while the user asked for it: refused; the stored config leaves out the processes that
+        # are off (_without_processes_off), so it never writes a null here
+        if isinstance(data, dict):
+            for name in PROCESSES:
+                if name in data and data[name] is None:
+                    raise ValueError(f"{name} = null (nothing after '{name}:'): give {{}} for "
+                                     "its published defaults, or leave the key out to turn it "
+                                     "off")
+        return data
+
+    @model_serializer(mode="wrap")
+    def _without_processes_off(self, handler):
+        return {k: v for k, v in handler(self).items() if not (k in PROCESSES and v is None)}
 
     def processes(self) -> list[tuple[str, object]]:
         """(name, settings) of the processes that are on, in the order of their channels."""
