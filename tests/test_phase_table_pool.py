@@ -49,3 +49,25 @@ def test_the_same_scene_packs_the_same_pool_each_time():
     assert first[0].tobytes() == again[0].tobytes()
     np.testing.assert_array_equal(first[1], again[1])
     np.testing.assert_array_equal(first[2], again[2])
+
+
+def test_a_table_of_part_of_the_angles_is_refused(tmp_path):
+    """A phase table's ends are extrapolated (2 pi p sin psi linear to 0 at 0 and 180 deg):
+    one that stops short of 10 or 170 deg (a forward hemisphere, say) is refused in one line
+    naming the file and its range, where its backscatter was invented with exit status 0."""
+    from oceanmc.scene.phase_tables import TableError, user_table
+    half = tmp_path / "half.csv"
+    half.write_text("angle,value\n0,10\n90,1\n")
+    try:
+        user_table(half)
+    except TableError as exc:
+        message = str(exc)
+    else:
+        raise AssertionError("a table of 0..90 deg was accepted")
+    assert message == (f"phase table {half}: its angles run 0..90 deg; a phase function table "
+                       "must reach from at most 10 deg to at least 170 deg (beyond its ends "
+                       "2 pi p sin(psi) goes linearly to 0 at 0 and 180 deg)")
+    near = tmp_path / "near.csv"
+    near.write_text("angle,value\n10,1\n90,0.1\n170,0.05\n")
+    psi = user_table(near)[0]
+    assert psi[0] == 0.0 and psi[-1] == np.pi

@@ -220,6 +220,15 @@ def numeric_rows(path: Path, what: str) -> list[tuple[int, list[float]]]:
     return rows
 
 
+# how far short of 0 and 180 deg a phase function table may stop: its ends are extrapolated
+# (user_table), which near 180 deg is close to exact (p nearly flat there, 2 pi p sin psi then
+# linear) but at the forward end misses what a peak puts there (Petzold's table starts at
+# 0.1 deg); a table that stops further out is refused as partial: one of a hemisphere would
+# have the other invented
+MAX_FIRST_ANGLE_DEG = 10.0
+MIN_LAST_ANGLE_DEG = 170.0
+
+
 def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
     """(angle_deg, p) from a two-column file: scattering angle (deg, 0..180, strictly increasing)
     and phase value (>= 0, any scale). Comma or whitespace separated; lines starting with '#' and a
@@ -248,6 +257,13 @@ def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
         bad = int(np.argmin(np.diff(angle) > 0.0)) + 1
         raise TableError(f"phase table {path}: angles must increase strictly (row {bad + 1}: "
                          f"{angle[bad]} after {angle[bad - 1]})")
+    if angle[0] > MAX_FIRST_ANGLE_DEG or angle[-1] < MIN_LAST_ANGLE_DEG:
+        # the ends are extrapolated (2 pi p sin psi linear to 0 at 0 and 180 deg: user_table);
+        # over a missing half of the sphere that would invent the light scattered there
+        raise TableError(f"phase table {path}: its angles run {angle[0]:g}..{angle[-1]:g} deg; "
+                         f"a phase function table must reach from at most "
+                         f"{MAX_FIRST_ANGLE_DEG:g} deg to at least {MIN_LAST_ANGLE_DEG:g} deg "
+                         "(beyond its ends 2 pi p sin(psi) goes linearly to 0 at 0 and 180 deg)")
     if np.any(p < 0.0):
         raise TableError(f"phase table {path}: negative phase value {p[p < 0][0]}")
     return angle, p
