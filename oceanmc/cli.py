@@ -164,6 +164,9 @@ def cmd_run(args: argparse.Namespace) -> int:
                 previous = partial_run(out, run, path)
             except CannotResume as exc:
                 raise UsageError(f"--resume: {exc}") from None
+        elif args.resume:   # (a resubmitted job whose first try never wrote: not an error)
+            print(f"oceanmc: --resume: no file at {out} to continue; running {path} from the "
+                  "start", file=sys.stderr, flush=True)
         scenes.append((path, run, RunFile(out, previous, args.overwrite)))
 
     stop = StopRequest()

@@ -236,3 +236,14 @@ def test_ctrl_c_while_compiling_stops_at_once_without_a_file(tmp_path, scene_fil
     assert proc.returncode == 130
     assert "while compiling the photon loop" in rest and "no file was written" in rest
     assert not out.exists() and not list(tmp_path.glob(".out.h5.*"))
+
+
+def test_resume_with_no_file_says_so_and_runs_from_the_start(tmp_path, scene_file):
+    """--resume where no file was ever written (a resubmitted job whose first try ended before
+    its first checkpoint) runs the scene from the start and says so, exit status 0."""
+    done = oceanmc("run", scene_file, "-o", "fresh.h5", "--resume", "--photons", "2000", "-q",
+                   cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert f"--resume: no file at fresh.h5 to continue; running {scene_file} from the start" \
+        in done.stderr
+    assert (tmp_path / "fresh.h5").is_file() and "budget total" in done.stdout
