@@ -257,9 +257,7 @@ def read_angle_table(path) -> tuple[np.ndarray, np.ndarray]:
         bad = int(np.argmin(np.diff(angle) > 0.0)) + 1
         raise TableError(f"phase table {path}: angles must increase strictly (row {bad + 1}: "
                          f"{angle[bad]} after {angle[bad - 1]})")
-    if angle[0] > MAX_FIRST_ANGLE_DEG or angle[-1] < MIN_LAST_ANGLE_DEG:
-        # the ends are extrapolated (2 pi p sin psi linear to 0 at 0 and 180 deg: user_table);
-        # over a missing half of the sphere that would invent the light scattered there
+    if angle[0] > MAX_FIRST_ANGLE_DEG or angle[-1] < MIN_LAST_ANGLE_DEG:   # (see the limits)
         raise TableError(f"phase table {path}: its angles run {angle[0]:g}..{angle[-1]:g} deg; "
                          f"a phase function table must reach from at most "
                          f"{MAX_FIRST_ANGLE_DEG:g} deg to at least {MIN_LAST_ANGLE_DEG:g} deg "
