@@ -11,6 +11,7 @@ import math
 import os
 import shutil
 import signal
+import stat
 import sys
 import tempfile
 from pathlib import Path
@@ -22,19 +23,65 @@ class UsageError(Exception):
     """Bad command-line input; the message says what and why."""
 
 
+# what -o takes as a results file's name (HDF5; h5netcdf reads .nc as well)
+RESULT_SUFFIXES = (".h5", ".hdf5", ".nc")
+
+
+def _names_a_folder(out: str) -> bool:
+    return out.endswith(("/", os.sep))
+
+
+def _existing(path: Path) -> str:
+    """'folder', 'file' (a regular one), 'other' (a device such as /dev/null, a FIFO, a socket)
+    or '' (nothing there, or a name the system cannot take: _check_writable says why)."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):   # ValueError: a NUL byte
+        return ""
+    return "folder" if stat.S_ISDIR(mode) else "file" if stat.S_ISREG(mode) else "other"
+
+
+def _results_file(out: str, option: str = "-o", suffixes: tuple[str, ...] = RESULT_SUFFIXES,
+                  what: str = "a results file") -> Path:
+    """The file -o names where the command writes one file: a name ending in one of suffixes,
+    not a folder, not a device or a FIFO (they would be replaced, or written into a name
+    beside them)."""
+    target = Path(out)
+    others = f" (or {', '.join(suffixes[1:])})" if len(suffixes) > 1 else ""
+    allowed = f"{what} name ending in {suffixes[0]}{others}"
+    if _names_a_folder(out) or _existing(target) == "folder":
+        raise UsageError(f"{option} {out}: a folder; {option} takes {allowed}")
+    if _existing(target) == "other":
+        raise UsageError(f"{option} {out}: not a regular file (a device, a FIFO or a socket); "
+                         f"{option} takes {allowed}")
+    if target.suffix.lower() not in suffixes:
+        raise UsageError(f"{option} {out}: {option} takes {allowed}")
+    return target
+
+
 def _outputs(configs: list[Path], out: str | None) -> list[Path]:
-    """One results file per config: -o FILE for a single config, -o DIR for several (or one),
-    else results/<config name>.h5."""
+    """One results file per config: -o FILE.h5 (.hdf5, .nc) for a single config; -o DIR (an
+    existing folder, a name ending in '/', or a name without a suffix, made if need be) for
+    one config or several, each file named after its config; else results/<config name>.h5.
+    Any other -o (another suffix such as .yaml, a device such as /dev/null) is refused."""
     if out is None:
         return [Path("results") / f"{c.stem}.h5" for c in configs]
     target = Path(out)
-    if target.suffix in (".h5", ".hdf5", ".nc") and not target.is_dir():
-        if len(configs) > 1:
-            raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
-        return [target]
-    if len(configs) == 1 and not target.is_dir() and not out.endswith(("/", os.sep)):
-        return [target.with_name(target.name + ".h5")]  # `-o name` means the file name.h5
-    return [target / f"{c.stem}.h5" for c in configs]
+    kind = _existing(target)
+    allowed = ("a results file name ending in .h5 (one config) or a folder (an existing one, "
+               "or a name ending in /)")
+    if out == "":
+        raise UsageError(f"-o '': an empty name; -o takes {allowed}")
+    if kind == "folder" or _names_a_folder(out) or (not target.suffix and kind == ""):
+        return [target / f"{c.stem}.h5" for c in configs]
+    if kind == "other":
+        raise UsageError(f"-o {out}: not a regular file (a device, a FIFO or a socket); -o "
+                         f"takes {allowed}")
+    if target.suffix.lower() not in RESULT_SUFFIXES:
+        raise UsageError(f"-o {out}: -o takes {allowed}")
+    if len(configs) > 1:
+        raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
+    return [target]
 
 
 def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0,
@@ -211,7 +258,7 @@ def cmd_merge(args: argparse.Namespace) -> int:
     from .run.merge import MergeError, merge_results
     from .run.summary import format_summary
 
-    out = Path(args.output)
+    out = _results_file(args.output)
     parts = []
     for name in args.files:
         path = Path(name)
@@ -279,12 +326,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from .sweeps import OutputExists, SweepError, sweep
 
     source = Path(args.sweep)
-    out = Path(args.output) if args.output else Path("results") / f"{source.stem}.nc"
+    out = _results_file(args.output, suffixes=(".nc",), what="a NetCDF file") if args.output \
+        else Path("results") / f"{source.stem}.nc"
     problem = file_problem(source)   # a FIFO or a device is "not a regular file", not missing
     if problem:
         raise UsageError(f"{source}: {problem}")
-    if out.suffix != ".nc":
-        raise UsageError(f"-o {out}: a sweep writes a NetCDF file; name it *.nc")
     _check_writable(out, overwrite=True)   # what the sweep may replace: sweep() judges it
     # the same signals, the same way, as `oceanmc run`: SIGTERM (a batch scheduler's) and a
     # SIGINT inherited as ignored (a background job of a script) stop it as Ctrl-C does
@@ -408,7 +454,9 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run one or more YAML scenes, write one HDF5 file each")
     run.add_argument("configs", nargs="+", metavar="CONFIG.yaml")
     run.add_argument("-o", "--output", metavar="OUT",
-                     help="results file (one config) or folder (default: results/<name>.h5)")
+                     help="results file OUT.h5 (one config), or a folder for <name>.h5 files: "
+                          "an existing one, or a name ending in / or without a suffix "
+                          "(default: results/<name>.h5)")
     run.add_argument("--photons", type=_positive_int, help="photon packets (overrides config)")
     run.add_argument("--seed", type=_non_negative_int, help="random seed (overrides config)")
     run.add_argument("--threads", type=_positive_int,

@@ -2,6 +2,7 @@
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -96,6 +97,42 @@ def test_missing_config_and_bad_options(tmp_path):
     assert done.returncode == 2 and "positive integer" in done.stderr
     done = oceanmc("frobnicate", cwd=tmp_path)
     assert done.returncode == 2
+
+
+def test_output_names_a_results_file_or_a_folder(tmp_path):
+    """-o: a name ending in .h5 is the file; an existing folder, a name ending in '/' or a name
+    without a suffix is the folder for <config name>.h5 (x.h5/ was the file x.h5)."""
+    from oceanmc.cli import _outputs
+    one, two = [tmp_path / "scene.yaml"], [tmp_path / "scene.yaml", tmp_path / "b.yaml"]
+    assert _outputs(one, "r.h5") == [Path("r.h5")]
+    assert _outputs(one, "x.h5/") == [Path("x.h5/scene.h5")]
+    assert _outputs(one, "newdir/") == [Path("newdir/scene.h5")]
+    assert _outputs(one, "newdir") == [Path("newdir/scene.h5")]   # was newdir.h5
+    assert _outputs(one, str(tmp_path)) == [tmp_path / "scene.h5"]
+    assert _outputs(two, "out") == [Path("out/scene.h5"), Path("out/b.h5")]
+
+
+@pytest.mark.parametrize("command, out, expected", [
+    ("run", "/dev/null", "-o /dev/null: not a regular file (a device, a FIFO or a socket); -o "
+     "takes a results file name ending in .h5 (one config) or a folder"),
+    ("run", "res.yaml", "-o res.yaml: -o takes a results file name ending in .h5 (one config) "
+     "or a folder (an existing one, or a name ending in /)"),
+    ("merge", "/dev/null", "-o /dev/null: not a regular file"),
+    ("merge", "m.yaml", "-o m.yaml: -o takes a results file name ending in .h5 (or .hdf5, .nc)"),
+    ("merge", "m.h5/", "-o m.h5/: a folder; -o takes a results file name ending in .h5"),
+    ("sweep", "lut.nc/", "-o lut.nc/: a folder; -o takes a NetCDF file name ending in .nc"),
+    ("sweep", "/dev/null", "-o /dev/null: not a regular file")])
+def test_output_that_is_not_a_results_file_is_refused_in_one_line(tmp_path, scene_file, command,
+                                                                   out, expected):
+    """`-o /dev/null` wrote /dev/null.h5, `-o res.yaml` res.yaml.h5, `merge -o m.h5/` the file
+    m.h5: each is refused before anything is written."""
+    inputs = [scene_file] if command != "merge" else [tmp_path / "a.h5", tmp_path / "b.h5"]
+    done = oceanmc(command, *inputs, "-o", out, *(["-q"] if command != "merge" else []),
+                   cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"oceanmc: error: {expected}"), done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
 
 
 def test_help_does_not_import_the_heavy_modules(tmp_path):
