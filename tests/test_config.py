@@ -46,6 +46,20 @@ def test_overrides_replace_photons_and_seed(small_scene):
     assert (config.photons, config.seed) == (1234, 9)
 
 
+@pytest.mark.parametrize("key, bad, override", [("photons", "many", 1234), ("seed", -1, 9)])
+def test_a_bad_value_in_the_file_is_refused_though_overridden(small_scene, key, bad, override):
+    """`photons: many` ran when --photons replaced it, the mistake in the file unsaid."""
+    small_scene[key] = bad
+    with pytest.raises(ConfigError, match=rf"^config: {key} = {bad!r}: .* \(the file's value, "
+                                          rf"which --{key} overrides, must be valid too\)$"):
+        load_config(small_scene, {key: override})
+
+
+def test_an_overridden_value_needs_only_to_be_valid_on_its_own(small_scene):
+    small_scene["photons"] = 10   # fewer than 2 per batch: the override decides
+    assert load_config(small_scene, {"photons": 1234}).photons == 1234
+
+
 def test_mixture_b_is_the_sum_of_its_components():
     scene = {"water": {"layers": [{"thickness_m": 1, "a": 0.1, "phase": {
         "model": "mixture", "components": [

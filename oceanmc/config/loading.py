@@ -333,9 +333,9 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
         raise ConfigError(f"{origin}: the top level must be a mapping of keys (name, photons, "
                           f"water, bottom, ...), got {type(data).__name__}")
     data = dict(data)
-    for key, value in (overrides or {}).items():
-        if value is not None:
-            data[key] = value
+    given = {key: value for key, value in (overrides or {}).items() if value is not None}
+    _check_overridden({key: data[key] for key in given if key in data}, origin)
+    data.update(given)
     try:
         config = SceneConfig.model_validate(data)
     except ValidationError as exc:
@@ -353,6 +353,23 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
         raise ConfigError(f"{origin}: nested too deeply to be a scene") from None
     _resolve_files(config, base_dir, origin)
     return config
+
+
+def _check_overridden(values: dict[str, Any], origin: str) -> None:
+    """The file's own values of the top-level keys the command line overrides (--photons,
+    --seed) are checked as well: `photons: many` is a mistake in the file whatever replaces
+    it. Validated alone (the scene's other keys missing): only these keys' errors count."""
+    if not values:
+        return
+    try:
+        SceneConfig.model_validate(values)
+    except ValidationError as exc:
+        errors = [e for e in exc.errors() if e["loc"][:1] in {(key,) for key in values}]
+        if errors:
+            first, _ = _first_problem(errors)
+            key = errors[0]["loc"][0]
+            raise ConfigError(f"{origin}: {first} (the file's value, which --{key} "
+                              "overrides, must be valid too)") from None
 
 
 def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
