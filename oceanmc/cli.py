@@ -457,7 +457,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="results file OUT.h5 (one config), or a folder for <name>.h5 files: "
                           "an existing one, or a name ending in / or without a suffix "
                           "(default: results/<name>.h5)")
-    run.add_argument("--photons", type=_positive_int, help="photon packets (overrides config)")
+    run.add_argument("--photons", type=_photon_count,
+                     help="photon packets, at most 1e13 (overrides config)")
     run.add_argument("--seed", type=_non_negative_int, help="random seed (overrides config)")
     run.add_argument("--threads", type=_positive_int,
                      help="threads (default: all cores); results do not depend on it")
@@ -570,6 +571,22 @@ def _positive_int(text: str) -> int:
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
     return value
+
+
+def _photon_count(text: str) -> int:
+    """--photons: a positive integer (1e7 as well) of at most the largest count a scene takes
+    (config.scene.MAX_PHOTONS), refused in readable digits: int('1e99') has 100."""
+    from .config.scene import MAX_PHOTONS   # here: --help does not import the schema
+
+    try:
+        number = float(text)   # 1e400 and a 400-digit integer: inf
+    except ValueError:
+        number = math.nan
+    if number > MAX_PHOTONS:
+        shown = repr(text) if len(text) <= 24 else f"{number:.3g}"
+        raise argparse.ArgumentTypeError(f"{shown} is more than {MAX_PHOTONS:.0e} photons; "
+                                         f"allowed: 1 .. {MAX_PHOTONS:.0e}")
+    return _positive_int(text)
 
 
 def _seconds(text: str) -> float:

@@ -99,6 +99,17 @@ def test_missing_config_and_bad_options(tmp_path):
     assert done.returncode == 2
 
 
+@pytest.mark.parametrize("photons, shown", [("1e99", "'1e99'"), ("1e400", "'1e400'"),
+                                            ("9" * 90, "1e+90")])
+def test_photons_above_the_limit_are_refused_in_readable_digits(tmp_path, photons, shown):
+    """--photons 1e99 was echoed back as an 80-digit integer (and 1e400 called not positive)."""
+    done = oceanmc("run", "x.yaml", "--photons", photons, cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.startswith(f"oceanmc run: error: argument --photons: {shown} is more than "
+                                  "1e+13 photons; allowed: 1 .. 1e+13"), done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and len(done.stderr) < 160
+
+
 def test_output_names_a_results_file_or_a_folder(tmp_path):
     """-o: a name ending in .h5 is the file; an existing folder, a name ending in '/' or a name
     without a suffix is the folder for <config name>.h5 (x.h5/ was the file x.h5)."""
