@@ -189,6 +189,29 @@ def test_every_point_is_validated_first_with_its_coordinates_one_line_exit_2(tmp
         build_points(load_sweep(sweep_file(tmp_path, {"tallies.depths_m": [[0], [0, 1]]})))
 
 
+@pytest.mark.parametrize("settings, axes, message", [
+    ({"illumination.sun_zenit_deg": 30}, {"bottom.reflectance": [0.1, 0.2]},
+     r"set: illumination\.sun_zenit_deg: unknown key; did you mean sun_zenith_deg\?"),
+    ({"water.layers[0].q": 1}, {"bottom.reflectance": [0.1, 0.2]},
+     r"set: water\.layers\[0\]\.q: unknown key \(check its spelling and level\)"),
+    ({"illumination.sun_zenith_deg": 300}, {"bottom.reflectance": [0.1, 0.2]},
+     r"set: illumination\.sun_zenith_deg = 300: Input should be less than 90"),
+    # at one point only: which one, and that the value is the set's
+    ({"photons": 10}, {"batches": [4, 8]},
+     r"point \(batches = 8\): set: photons = 10: need at least 2 per batch \(batches = 8\)"),
+    # the axis's value, not the set's: the point, as before
+    ({"bottom": {"model": "lambertian", "reflectance": 0.3}}, {"bottom.reflectance": [0.1, 1.5]},
+     r"point \(bottom\.reflectance = 1\.5\): bottom\.reflectance = 1\.5: Input should be")])
+def test_a_bad_value_under_set_is_named_as_the_sweep_file_gives_it(tmp_path, settings, axes,
+                                                                   message):
+    """A `set:` key the scene refuses was blamed on the first point, `(and N more points)`,
+    as if the axes' values were wrong; now the message starts `set:` (with the point only where
+    the problem is at some points and not others)."""
+    with pytest.raises(SweepError, match=f"^{message}") as info:
+        build_points(load_sweep(sweep_file(tmp_path, axes, set=settings)))
+    assert "\n" not in str(info.value) and "more point" not in str(info.value)
+
+
 def test_repeated_axis_values_and_too_many_batch_groups_are_refused_before_any_run(tmp_path):
     """A value given twice on an axis (the dataset's coordinate would hold it twice, and
     selecting it return two points), and batch_groups beyond what a point's batches allow

@@ -47,16 +47,26 @@ def build_points(spec: SweepSpec) -> list[Point]:
     coordinates (and how many more are bad)."""
     points: list[Point] = []
     bad: list[str] = []
+    from_set: list[str] = []   # the problems of a value the sweep file's `set:` gives
+    count = 0
     for index, assignments in spec.points():
+        count += 1
         where = spec.label(assignments)   # by the names the sweep file gave its axes
         try:
             config = load_config(spec.scene_at(assignments), base_dir=spec.base_dir)
         except SweepError as exc:
             raise SweepError(str(exc)) from None   # a key path the base scene does not have
         except ConfigError as exc:
-            bad.append(f"point ({where}): {_without_origin(exc)}")
+            text = _without_origin(exc)
+            if _set_by(text, spec.settings) and not _set_by(text, dict(assignments)):
+                from_set.append(text)
+                text = f"set: {text}"
+            bad.append(f"point ({where}): {text}")
             continue
         points.append(Point(index, where, config, config_to_yaml(config)))
+    if bad and len(from_set) == count and len(set(from_set)) == 1:
+        # the same problem at every point: the set value alone, whatever the axes
+        raise SweepError(f"set: {from_set[0]}")
     if bad:
         _raise_first(bad)
     _check_same_tallies(points)
@@ -98,6 +108,13 @@ def check_scenes(points: list[Point]) -> None:
             bad.append(f"point ({point.label}): {_without_origin(exc)}")
     if bad:
         _raise_first(bad)
+
+
+def _set_by(problem: str, values: dict) -> bool:
+    """Whether a point's problem (`KEY.PATH = value: ...`, `KEY.PATH: unknown key`) is at or
+    under one of these key paths (the sweep file's `set:` keys, or a point's axis keys)."""
+    return any(problem.startswith(str(key)) and problem[len(str(key)):][:1] in (":", " ", ".", "[")
+               for key in values)
 
 
 def _without_origin(exc: ConfigError) -> str:
