@@ -156,6 +156,18 @@ def test_config_files_that_are_not_regular_or_too_large_are_refused(tmp_path):
     refused(str(tmp_path / "a\0b.yaml"), "cannot read it")
 
 
+@pytest.mark.parametrize("text, at", [("a: &x [*x]\n", "line 1, column 4"),
+                                      ("name: x\nwater: &w\n  layers: [*w]\n", "line 2, column 8"),
+                                      ("b: &y {c: [1, {d: *y}]}\n", "line 1, column 4")])
+def test_a_recursive_yaml_alias_is_called_so(tmp_path, text, at):
+    """`a: &x [*x]` was reported as aliases expanding to more than 100,000 values."""
+    path = tmp_path / "loop.yaml"
+    path.write_text(text)
+    message = refused(path, f"{path}: not valid for a scene: {at}: an anchor's value holds an "
+                      "alias to that anchor (a recursive alias")
+    assert "100,000" not in message
+
+
 def test_yaml_alias_bomb_duplicate_keys_and_syntax_errors(tmp_path, small_scene):
     bomb = tmp_path / "bomb.yaml"
     lines = ["a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]"]

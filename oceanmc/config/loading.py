@@ -83,21 +83,34 @@ class _SceneLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+class _RecursiveAlias(Exception):
+    """An alias inside the node its anchor names (`a: &x [*x]`): it expands without end."""
+
+    def __init__(self, node: yaml.Node) -> None:
+        super().__init__()
+        self.mark = node.start_mark
+
+
 def _expanded_size(node: yaml.Node) -> int:
     """Nodes in the document with every alias expanded, computed on the composed graph (where
-    an alias is a shared node) without expanding it."""
+    an alias is a shared node) without expanding it. Raises _RecursiveAlias for a node that
+    holds itself."""
     sizes: dict[int, int] = {}
+    open_nodes: set[int] = set()   # the nodes being counted: one met again holds itself
 
     def size(n: yaml.Node) -> int:
+        if id(n) in open_nodes:
+            raise _RecursiveAlias(n)
         if id(n) in sizes:
             return sizes[id(n)]
-        sizes[id(n)] = MAX_YAML_NODES + 1  # a recursive alias counts as too many
+        open_nodes.add(id(n))
         if isinstance(n, yaml.SequenceNode):
             total = 1 + sum(size(child) for child in n.value)
         elif isinstance(n, yaml.MappingNode):
             total = 1 + sum(size(k) + size(v) for k, v in n.value)
         else:
             total = 1
+        open_nodes.discard(id(n))
         sizes[id(n)] = min(total, MAX_YAML_NODES + 1)
         return sizes[id(n)]
     return size(node)
@@ -165,7 +178,14 @@ def _parse_yaml(text: str, origin: str, kind: str = "scene") -> Any:
             node = loader.get_single_node()
             if node is None:
                 return None
-            if _expanded_size(node) > MAX_YAML_NODES:
+            try:
+                too_many = _expanded_size(node) > MAX_YAML_NODES
+            except _RecursiveAlias as exc:
+                at = f"line {exc.mark.line + 1}, column {exc.mark.column + 1}"
+                raise ConfigError(f"{origin}: not valid for a {kind}: {at}: an anchor's value "
+                                  "holds an alias to that anchor (a recursive alias such as "
+                                  "`a: &x [*x]`), which expands without end") from None
+            if too_many:
                 raise ConfigError(f"{origin}: its aliases expand to more than "
                                   f"{MAX_YAML_NODES:,} values; a {kind} needs far fewer")
             return loader.construct_document(node)
