@@ -49,7 +49,7 @@ def test_extreme_axis_and_set_values_give_valid_points_or_one_line_naming_the_po
     for value in VALUES:
         for spec, start in (({"base": TINY, "axes": {key: [0.5, value]}},
                              f"point ({key} = "), ({"base": TINY, "set": {key: value}},
-                                                   "point (): ")):
+                                                   (f"set: {key}", "point (): "))):
             got = points_or_one_line(spec)
             if isinstance(got, str):   # the key, or for a refusal across keys its value
                 assert got.startswith(start), got
