@@ -168,6 +168,49 @@ def test_a_boolean_for_a_number_is_refused(small_scene, change, message):
                                           "and off as booleans)")
 
 
+@pytest.mark.parametrize("line, message", [
+    ("  sun_zenith_deg: '30'", "illumination.sun_zenith_deg = '30'"),
+    ('  sun_zenith_deg: "1e1"', "illumination.sun_zenith_deg = '1e1'"),
+    ("  depths_m: [0, '1']", "tallies.depths_m[1] = '1'")])
+def test_a_quoted_number_is_refused(tmp_path, small_scene, line, message):
+    """`sun_zenith_deg: '30'` ran as 30 (pydantic reads the string as a number): a number in
+    the scene is written as a number."""
+    del small_scene["illumination"]["sun_zenith_deg"], small_scene["tallies"]
+    text = yaml.safe_dump(small_scene).replace("illumination:\n", "illumination:\n" + line + "\n")
+    if "depths_m" in line:
+        text = yaml.safe_dump(small_scene) + "tallies:\n" + line + "\n"
+    path = tmp_path / "scene.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value) == (f"{path}: {message}: expected a number, got a string (write the "
+                               "number without quotes)")
+
+
+def test_a_quoted_number_is_refused_where_a_name_is_allowed_too(small_scene):
+    small_scene["estimator"] = {"upward_fraction": "0.5"}   # a number, 'auto' or null
+    assert _error(small_scene) == ("config: estimator.upward_fraction = '0.5': expected a "
+                                   "number, got a string (write the number without quotes)")
+    small_scene["estimator"] = {"upward_fraction": "auto"}
+    assert load_config(small_scene).estimator.upward_fraction == "auto"
+
+
+def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(
+        tmp_path, small_scene):
+    """YAML 1.1 reads 1e-1 and 2.5e1 (no decimal point, or an unsigned exponent) as strings;
+    they are read as numbers (else refused as quoted); a name '1e6' stays a name through the
+    stored config."""
+    small_scene["name"] = "1e6"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("name: 1e6", "name: '1e6'")
+                    .replace("a: 0.1", "a: 1e-1")
+                    .replace("sun_zenith_deg: 30", "sun_zenith_deg: 2.5e1"))
+    config = load_config(path)
+    assert (config.water.layers[0].a, config.illumination.sun_zenith_deg) == (0.1, 25.0)
+    path.write_text(config_to_yaml(config))
+    assert load_config(path) == config and config.name == "1e6"
+
+
 def test_a_blank_inelastic_process_is_refused_and_the_stored_config_leaves_out_those_off(
         small_scene):
     """`raman:` with nothing after it is YAML's null, which turned Raman scattering off (exit

@@ -6,6 +6,7 @@ import typing
 from typing import Annotated, Any
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+from pydantic_core import PydanticCustomError
 
 
 class ConfigError(ValueError):
@@ -39,6 +40,45 @@ def _expected(annotation: Any) -> str:
     return "a list" if origin in (list, tuple) else "a number"
 
 
+def _members(annotation: Any) -> list[Any]:
+    """The types a value may take under an annotation: through Annotated and unions."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return _members(typing.get_args(annotation)[0])
+    if origin in (typing.Union, types.UnionType):
+        return [m for a in typing.get_args(annotation) for m in _members(a)]
+    return [annotation]
+
+
+def _string_for_a_number(value: Any, annotations: list[Any]) -> tuple[str, str] | None:
+    """(where, the string) of a string given where only a number is allowed (`'30'`, a number
+    quoted in the YAML), in value or the lists it holds: where is '' or list indices ('[1]');
+    None if there is none. A member that takes the string (str, Any, a Literal holding it such
+    as 'hydrolight' or 'auto') lets it through, as does an annotation without a number (a
+    model's own checks judge what it is given)."""
+    members = [m for a in annotations for m in _members(a)]
+    if isinstance(value, str):
+        takes_string = any(m in (str, Any) or (typing.get_origin(m) is typing.Literal
+                                               and value in typing.get_args(m))
+                           for m in members)
+        numbers = any(m in (int, float) for m in members)
+        return ("", value) if numbers and not takes_string else None
+    if isinstance(value, (list, tuple)):
+        items = [a for m in members if typing.get_origin(m) in (list, tuple)
+                 for a in typing.get_args(m) if a is not Ellipsis]
+        if not items:
+            return None
+        for i, item in enumerate(value):
+            found = _string_for_a_number(item, items)
+            if found is not None:
+                return f"[{i}]{found[0]}", found[1]
+    return None
+
+
+# the type of the error for a number given as a string (config/loading.py _describe)
+QUOTED_NUMBER = "quoted_number"
+
+
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", validate_default=True)
 
@@ -56,7 +96,33 @@ class _Strict(BaseModel):
                     raise ValueError(f"{name} = {value}: expected "
                                      f"{_expected(field.annotation)} (YAML reads true, false, "
                                      "yes, no, on and off as booleans)")
+                # pydantic reads the string '30' as 30: a number quoted in the YAML ran as the
+                # number. Other strings are left to pydantic's message, as is a field whose own
+                # validator reads strings (photons' '1e6'). The error's type tells
+                # config/loading.py to name the key below the model's path
+                found = _string_for_a_number(value, [field.annotation]) \
+                    if field is not None and name not in cls._reads_strings() else None
+                if found is not None and _looks_like_a_number(found[1]):
+                    raise PydanticCustomError(
+                        QUOTED_NUMBER, "{key} = {value!r}: expected a number, got a string",
+                        {"key": f"{name}{found[0]}", "value": found[1]})
         return data
+
+    @classmethod
+    def _reads_strings(cls) -> set[str]:
+        """The fields with a validator of their own that runs before pydantic's (this one,
+        on every field, aside)."""
+        return {name for decorator in cls.__pydantic_decorators__.field_validators.values()
+                if decorator.info.mode in ("before", "wrap", "plain")
+                for name in decorator.info.fields if name != "*"}
+
+
+def _looks_like_a_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
