@@ -211,6 +211,24 @@ def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_ro
     assert load_config(path) == config and config.name == "1e6"
 
 
+def test_a_gaussian_profile_given_integral_and_total_mg_m2_says_they_are_one_quantity(
+        small_scene):
+    """The README accepts total_mg_m2 for integral; both given was called an unknown key."""
+    profile = {"profile": "gaussian", "background": 0.1, "peak_depth_m": 1.0, "width_m": 0.5,
+               "integral": 2.0, "total_mg_m2": 3.0}
+    small_scene["water"]["layers"][0]["components"] = [
+        {"model": "pure_water"}, {"model": "chlorophyll", "chl_mg_m3": profile}]
+    for key in ("a", "b", "phase"):
+        del small_scene["water"]["layers"][0][key]
+    small_scene["wavelengths_nm"] = [550.0]
+    assert _error(small_scene) == (
+        "config: water.layers[0].components[1].chl_mg_m3: integral = 2.0 and total_mg_m2 = "
+        "3.0: the same quantity given twice (total_mg_m2 is another name for integral); give "
+        "one of them")
+    del profile["integral"]
+    assert load_config(small_scene).water.layers[0].components[1].chl_mg_m3.integral == 3.0
+
+
 def test_a_blank_inelastic_process_is_refused_and_the_stored_config_leaves_out_those_off(
         small_scene):
     """`raman:` with nothing after it is YAML's null, which turned Raman scattering off (exit

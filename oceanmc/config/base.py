@@ -89,8 +89,11 @@ class _Strict(BaseModel):
         # false as booleans: `a: yes` would run with a = 1 (a boolean where a number, a list
         # or a table is expected is refused here, naming the key)
         if isinstance(data, dict):
+            names = cls._input_names()
+            cls._no_name_twice(data, names)
             for name, value in data.items():
-                field = cls.model_fields.get(name) if isinstance(name, str) else None
+                field = cls.model_fields.get(names.get(name, "")) if isinstance(name, str) \
+                    else None
                 if isinstance(value, bool) and field is not None \
                         and not _admits_boolean(field.annotation):
                     raise ValueError(f"{name} = {value}: expected "
@@ -110,11 +113,38 @@ class _Strict(BaseModel):
 
     @classmethod
     def _reads_strings(cls) -> set[str]:
-        """The fields with a validator of their own that runs before pydantic's (this one,
-        on every field, aside)."""
+        """The fields with a validator of their own that runs before pydantic's."""
         return {name for decorator in cls.__pydantic_decorators__.field_validators.values()
                 if decorator.info.mode in ("before", "wrap", "plain")
-                for name in decorator.info.fields if name != "*"}
+                for name in decorator.info.fields}
+
+    @classmethod
+    def _input_names(cls) -> dict[str, str]:
+        """{a key the input may use: its field's name}: each field's own name, and the other
+        names its validation_alias accepts (a gaussian profile's total_mg_m2 for integral)."""
+        names = {}
+        for field_name, field in cls.model_fields.items():
+            names[field_name] = field_name
+            for choice in getattr(field.validation_alias, "choices", ()):
+                if isinstance(choice, str):
+                    names[choice] = field_name
+        return names
+
+    @staticmethod
+    def _no_name_twice(data: dict, names: dict[str, str]) -> None:
+        """One quantity given under two of its names (integral and total_mg_m2) is refused
+        as such: pydantic took the first and called the other an unknown key."""
+        given: dict[str, list[str]] = {}
+        for key in data:
+            if isinstance(key, str) and key in names:
+                given.setdefault(names[key], []).append(key)
+        for field_name, keys in given.items():
+            if len(keys) > 1:
+                other = next(k for k in keys if k != field_name)
+                raise ValueError(
+                    f"{keys[0]} = {data[keys[0]]!r} and {keys[1]} = {data[keys[1]]!r}: the same "
+                    f"quantity given twice ({other} is another name for {field_name}); give "
+                    "one of them")
 
 
 def _looks_like_a_number(text: str) -> bool:
