@@ -170,11 +170,13 @@ def test_a_boolean_for_a_number_is_refused(small_scene, change, message):
 
 @pytest.mark.parametrize("line, message", [
     ("  sun_zenith_deg: '30'", "illumination.sun_zenith_deg = '30'"),
-    ('  sun_zenith_deg: "1e1"', "illumination.sun_zenith_deg = '1e1'"),
-    ("  depths_m: [0, '1']", "tallies.depths_m[1] = '1'")])
+    ('  sun_zenith_deg: "1.5e+1"', "illumination.sun_zenith_deg = '1.5e+1'"),
+    ("  depths_m: [0, '1']", "tallies.depths_m[1] = '1'"),
+    ("  depths_m: [1e-1, '1']", "tallies.depths_m[1] = '1'")])
 def test_a_quoted_number_is_refused(tmp_path, small_scene, line, message):
     """`sun_zenith_deg: '30'` ran as 30 (pydantic reads the string as a number): a number in
-    the scene is written as a number."""
+    the scene is written as a number. (A quoted '1e1' is read as the number: it cannot be told
+    from an unquoted 1e1, which YAML 1.1 reads as a string; '1.5e+1' it reads as a number.)"""
     del small_scene["illumination"]["sun_zenith_deg"], small_scene["tallies"]
     text = yaml.safe_dump(small_scene).replace("illumination:\n", "illumination:\n" + line + "\n")
     if "depths_m" in line:
@@ -197,18 +199,23 @@ def test_a_quoted_number_is_refused_where_a_name_is_allowed_too(small_scene):
 
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(
         tmp_path, small_scene):
-    """YAML 1.1 reads 1e-1 and 2.5e1 (no decimal point, or an unsigned exponent) as strings;
-    they are read as numbers (else refused as quoted); a name '1e6' stays a name through the
-    stored config."""
+    """YAML 1.1 (PyYAML, which reads the stored configs back) reads 1e-1 and 2.5e1 (no decimal
+    point, or an unsigned exponent) as strings: they are let through as the numbers, from a
+    file and from a dict of yaml.safe_load alike (a YAML 1.2 loader had made the dict's strings
+    'quoted numbers' and the unquoted name 1e6 a float, which no longer loaded back)."""
     small_scene["name"] = "1e6"
+    text = (yaml.safe_dump(small_scene).replace("a: 0.1", "a: 1e-1")
+            .replace("sun_zenith_deg: 30", "sun_zenith_deg: 2.5e1"))
+    assert "name: 1e6\n" in text   # safe_dump writes the name unquoted: YAML 1.1 reads text
     path = tmp_path / "scene.yaml"
-    path.write_text(yaml.safe_dump(small_scene).replace("name: 1e6", "name: '1e6'")
-                    .replace("a: 0.1", "a: 1e-1")
-                    .replace("sun_zenith_deg: 30", "sun_zenith_deg: 2.5e1"))
+    path.write_text(text)
     config = load_config(path)
     assert (config.water.layers[0].a, config.illumination.sun_zenith_deg) == (0.1, 25.0)
-    path.write_text(config_to_yaml(config))
-    assert load_config(path) == config and config.name == "1e6"
+    assert config.name == "1e6" and load_config(yaml.safe_load(text)) == config
+    stored = config_to_yaml(config)
+    assert "name: 1e6\n" in stored and yaml.safe_load(stored)["name"] == "1e6"
+    path.write_text(stored)
+    assert load_config(path) == config and load_config(yaml.safe_load(stored)) == config
 
 
 def test_a_gaussian_profile_given_integral_and_total_mg_m2_says_they_are_one_quantity(

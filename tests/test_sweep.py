@@ -468,6 +468,29 @@ def test_another_sweeps_dataset_is_refused_without_overwrite_and_a_rerun_is_not(
     assert "notes.nc exists and is not an oceanmc sweep dataset" in done.stderr
 
 
+def test_a_dataset_of_a_sweep_in_e_notation_is_its_own_on_a_rerun(tmp_path):
+    """A sweep file with 4e-1 and 1e-1 (strings to YAML 1.1) in its base and on an axis: its
+    dataset's base_scene_yaml and sweep_yaml, as stored from them and read back with
+    yaml.safe_load, are this sweep's, not another's (a YAML 1.2 loader made the file's values
+    numbers, and such a dataset 'another sweep' on a rerun or a resume)."""
+    import h5py
+
+    from oceanmc.run.format import SWEEP_TITLE
+    from oceanmc.sweeps.dataset import check_replaceable
+
+    base = copy.deepcopy(TINY)
+    base["water"]["layers"][0]["b"] = "4e-1"
+    path = sweep_file(tmp_path, {"water.layers[0].a": ["1e-1", "2e-1"]}, base=base)
+    assert "b: 4e-1\n" in path.read_text() and "- 1e-1\n" in path.read_text()
+    written = yaml.safe_load(path.read_text())
+    out = tmp_path / "lut.nc"
+    with h5py.File(out, "w") as f:
+        f.attrs["title"] = SWEEP_TITLE
+        f.attrs["base_scene_yaml"] = yaml.safe_dump(written["base"], sort_keys=False)
+        f.attrs["sweep_yaml"] = yaml.safe_dump({"set": {}, "axes": written["axes"]})
+    check_replaceable(out, tmp_path / "lut.points", load_sweep(path))   # no OutputExists
+
+
 # --- SIGTERM, and SIGINT inherited as ignored (a background job of a script) ---------------------
 
 def _ignore_sigint():

@@ -1,10 +1,12 @@
 """What every part of the schema shares: the error type, the strict base model, number types."""
 from __future__ import annotations
 
+import re
 import types
 import typing
 from typing import Annotated, Any
 
+import yaml
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 from pydantic_core import PydanticCustomError
 
@@ -51,18 +53,18 @@ def _members(annotation: Any) -> list[Any]:
 
 
 def _string_for_a_number(value: Any, annotations: list[Any]) -> tuple[str, str] | None:
-    """(where, the string) of a string given where only a number is allowed (`'30'`, a number
-    quoted in the YAML), in value or the lists it holds: where is '' or list indices ('[1]');
-    None if there is none. A member that takes the string (str, Any, a Literal holding it such
-    as 'hydrolight' or 'auto') lets it through, as does an annotation without a number (a
-    model's own checks judge what it is given)."""
+    """(where, the string) of a number given as a string where only a number is allowed
+    (`'30'`, a number quoted in the YAML; see _quoted_number), in value or the lists it holds:
+    where is '' or list indices ('[1]'); None if there is none. A member that takes the string
+    (str, Any, a Literal holding it such as 'hydrolight' or 'auto') lets it through, as does an
+    annotation without a number (a model's own checks judge what it is given)."""
     members = [m for a in annotations for m in _members(a)]
     if isinstance(value, str):
         takes_string = any(m in (str, Any) or (typing.get_origin(m) is typing.Literal
                                                and value in typing.get_args(m))
                            for m in members)
         numbers = any(m in (int, float) for m in members)
-        return ("", value) if numbers and not takes_string else None
+        return ("", value) if numbers and not takes_string and _quoted_number(value) else None
     if isinstance(value, (list, tuple)):
         items = [a for m in members if typing.get_origin(m) in (list, tuple)
                  for a in typing.get_args(m) if a is not Ellipsis]
@@ -105,7 +107,7 @@ class _Strict(BaseModel):
                 # config/loading.py to name the key below the model's path
                 found = _string_for_a_number(value, [field.annotation]) \
                     if field is not None and name not in cls._reads_strings() else None
-                if found is not None and _looks_like_a_number(found[1]):
+                if found is not None:
                     raise PydanticCustomError(
                         QUOTED_NUMBER, "{key} = {value!r}: expected a number, got a string",
                         {"key": f"{name}{found[0]}", "value": found[1]})
@@ -147,12 +149,25 @@ class _Strict(BaseModel):
                     "one of them")
 
 
-def _looks_like_a_number(text: str) -> bool:
+# A number written with an exponent: PyYAML reads YAML 1.1, where only one with a decimal
+# point and a signed exponent (1.5e-3) is a float; 1e-3, 1e6 and 2.5e3 are read as strings
+# (as yaml.safe_load reads them wherever a stored config or sweep is read back)
+_EXPONENT_NUMBER = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
+_YAML_RESOLVER = yaml.resolver.Resolver()
+
+
+def _quoted_number(text: str) -> bool:
+    """Whether a string given for a number is a number in quotes ('30', '0.5', '1.5e-3'), to be
+    refused, rather than what PyYAML makes of an unquoted exponent number (1e-3, 2.5e3, 1e6:
+    strings under YAML 1.1), let through for pydantic to read as the number, as it always was.
+    The limitation: a quoted '1e-3' cannot be told from an unquoted 1e-3 and is read as the
+    number too."""
     try:
         float(text)
     except ValueError:
         return False
-    return True
+    unquoted = _YAML_RESOLVER.resolve(yaml.ScalarNode, text, (True, False))
+    return not (_EXPONENT_NUMBER.match(text) and unquoted == "tag:yaml.org,2002:str")
 
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]

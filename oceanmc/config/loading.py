@@ -6,7 +6,6 @@ import difflib
 import hashlib
 import json
 import os
-import re
 import stat
 import textwrap
 import types
@@ -68,16 +67,9 @@ MAX_TABLE_BYTES = 1 << 28
 MAX_YAML_NODES = 100_000   # after aliases are expanded: stops "billion laughs" alias bombs
 
 
-# YAML 1.1 (PyYAML) reads a number written with an exponent but no decimal point, or with an
-# unsigned exponent (1e-3, 1e6, 2.5e3), as a string; YAML 1.2 and every user read it as a
-# number, and a string is refused where a number is expected (config/base.py)
-_EXPONENT_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
-
-
 class _SceneLoader(yaml.SafeLoader):
-    """yaml.SafeLoader that reads 1e-3 and 2.5e3 as numbers (as YAML 1.2 does), refuses a key
-    given twice in one mapping (the second would silently win) and documents whose aliases
-    expand to more than MAX_YAML_NODES nodes."""
+    """yaml.SafeLoader that refuses a key given twice in one mapping (the second would silently
+    win) and documents whose aliases expand to more than MAX_YAML_NODES nodes."""
 
     def construct_mapping(self, node, deep=False):
         seen = set()
@@ -97,18 +89,6 @@ class _RecursiveAlias(Exception):
     def __init__(self, node: yaml.Node) -> None:
         super().__init__()
         self.mark = node.start_mark
-
-
-_SceneLoader.add_implicit_resolver("tag:yaml.org,2002:float", _EXPONENT_FLOAT,
-                                   list("-+0123456789."))
-
-
-class _SceneDumper(yaml.SafeDumper):
-    """Writes a string that _SceneLoader would read as a number (a name '1e6') in quotes."""
-
-
-_SceneDumper.add_implicit_resolver("tag:yaml.org,2002:float", _EXPONENT_FLOAT,
-                                   list("-+0123456789."))
 
 
 def _expanded_size(node: yaml.Node) -> int:
@@ -489,8 +469,7 @@ def config_to_yaml(config: SceneConfig, spectrum: tuple | None = None) -> str:
     diffuse_fraction (YAML comments: the text still loads as the same scene). `spectrum`: the
     (Ed0, diffuse_fraction) arrays already computed by optics.illumination_spectrum, else they
     are computed here (and left out if they cannot be)."""
-    text = yaml.dump(config.model_dump(), Dumper=_SceneDumper, sort_keys=False,
-                     allow_unicode=True)
+    text = yaml.safe_dump(config.model_dump(), sort_keys=False, allow_unicode=True)
     if config.illumination.spectrum.model == "flat":
         return text
     if spectrum is None:
