@@ -60,26 +60,31 @@ def _results_file(out: str, option: str = "-o", suffixes: tuple[str, ...] = RESU
 
 
 def _outputs(configs: list[Path], out: str | None) -> list[Path]:
-    """One results file per config: -o FILE.h5 (.hdf5, .nc) for a single config; -o DIR (an
-    existing folder, a name ending in '/', or a name without a suffix, made if need be) for
-    one config or several, each file named after its config; else results/<config name>.h5.
-    Any other -o (another suffix such as .yaml, a device such as /dev/null) is refused."""
+    """One results file per config: -o FILE.h5 (.hdf5, .nc) for a single config, and -o NAME
+    without a suffix (not an existing folder) the file NAME.h5; -o DIR (an existing folder, a
+    name ending in '/', or, for several configs, a name without a suffix, made if need be)
+    gets each file named after its config; else results/<config name>.h5. Any other -o
+    (another suffix such as .yaml, a device such as /dev/null) is refused."""
     if out is None:
         return [Path("results") / f"{c.stem}.h5" for c in configs]
     target = Path(out)
     kind = _existing(target)
-    allowed = ("a results file name ending in .h5 (one config) or a folder (an existing one, "
-               "or a name ending in /)")
+    allowed = ("a results file name ending in .h5 or without a suffix (NAME.h5; one config) "
+               "or a folder (an existing one, or a name ending in /)")
     if out == "":
         raise UsageError(f"-o '': an empty name; -o takes {allowed}")
-    if kind == "folder" or _names_a_folder(out) or (not target.suffix and kind == ""):
+    if kind == "folder" or _names_a_folder(out):
         return [target / f"{c.stem}.h5" for c in configs]
     if kind == "other":
         raise UsageError(f"-o {out}: not a regular file (a device, a FIFO or a socket); -o "
                          f"takes {allowed}")
-    if target.suffix.lower() not in RESULT_SUFFIXES:
+    if not target.suffix and len(configs) == 1:
+        return [target.with_name(target.name + ".h5")]   # `-o name` means the file name.h5
+    if not target.suffix and kind == "":
+        return [target / f"{c.stem}.h5" for c in configs]   # several: the folder name/
+    if target.suffix and target.suffix.lower() not in RESULT_SUFFIXES:
         raise UsageError(f"-o {out}: -o takes {allowed}")
-    if len(configs) > 1:
+    if len(configs) > 1:   # a .h5 name, or an existing file without a suffix
         raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
     return [target]
 
@@ -454,8 +459,9 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run one or more YAML scenes, write one HDF5 file each")
     run.add_argument("configs", nargs="+", metavar="CONFIG.yaml")
     run.add_argument("-o", "--output", metavar="OUT",
-                     help="results file OUT.h5 (one config), or a folder for <name>.h5 files: "
-                          "an existing one, or a name ending in / or without a suffix "
+                     help="results file OUT.h5 (one config; OUT without a suffix means "
+                          "OUT.h5), or a folder for <name>.h5 files: an existing one, or a "
+                          "name ending in / (or, for several configs, without a suffix) "
                           "(default: results/<name>.h5)")
     run.add_argument("--photons", type=_photon_count,
                      help="photon packets, at most 1e13 (overrides config)")

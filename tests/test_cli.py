@@ -111,23 +111,43 @@ def test_photons_above_the_limit_are_refused_in_readable_digits(tmp_path, photon
 
 
 def test_output_names_a_results_file_or_a_folder(tmp_path):
-    """-o: a name ending in .h5 is the file; an existing folder, a name ending in '/' or a name
-    without a suffix is the folder for <config name>.h5 (x.h5/ was the file x.h5)."""
-    from oceanmc.cli import _outputs
+    """-o: a name ending in .h5 is the file, and so, for one config, is a name without a suffix
+    (-o name: the file name.h5, as 884245e made it; f0c242a had made it the folder name/, where
+    `-o name --resume` no longer found the partial name.h5); an existing folder or a name
+    ending in '/' is the folder for <config name>.h5, as is a name without a suffix for several
+    configs (x.h5/ was the file x.h5)."""
+    from oceanmc.cli import UsageError, _outputs
     one, two = [tmp_path / "scene.yaml"], [tmp_path / "scene.yaml", tmp_path / "b.yaml"]
     assert _outputs(one, "r.h5") == [Path("r.h5")]
     assert _outputs(one, "x.h5/") == [Path("x.h5/scene.h5")]
     assert _outputs(one, "newdir/") == [Path("newdir/scene.h5")]
-    assert _outputs(one, "newdir") == [Path("newdir/scene.h5")]   # was newdir.h5
+    assert _outputs(one, "newdir") == [Path("newdir.h5")]
     assert _outputs(one, str(tmp_path)) == [tmp_path / "scene.h5"]
     assert _outputs(two, "out") == [Path("out/scene.h5"), Path("out/b.h5")]
+    (tmp_path / "plain").write_text("")   # a file without a suffix: one config writes plain.h5
+    assert _outputs(one, str(tmp_path / "plain")) == [tmp_path / "plain.h5"]
+    with pytest.raises(UsageError, match=r"plain: several configs need a folder for -o, not a "
+                                         r"file name$"):
+        _outputs(two, str(tmp_path / "plain"))
+
+
+def test_output_without_a_suffix_is_the_results_file_with_h5_added(tmp_path, scene_file):
+    """`-o out` writes out.h5 and a second `-o out` finds it (the file to --resume)."""
+    done = oceanmc("run", scene_file, "-o", "out", "--photons", "2000", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "wrote out.h5" in done.stdout and (tmp_path / "out.h5").is_file()
+    assert not (tmp_path / "out").exists()
+    again = oceanmc("run", scene_file, "-o", "out", "-q", cwd=tmp_path)
+    assert again.returncode == 2
+    assert again.stderr.startswith("oceanmc: error: out.h5 exists; pass --overwrite to replace it "
+                                   "(or --resume to continue a partial run)"), again.stderr
 
 
 @pytest.mark.parametrize("command, out, expected", [
     ("run", "/dev/null", "-o /dev/null: not a regular file (a device, a FIFO or a socket); -o "
-     "takes a results file name ending in .h5 (one config) or a folder"),
-    ("run", "res.yaml", "-o res.yaml: -o takes a results file name ending in .h5 (one config) "
-     "or a folder (an existing one, or a name ending in /)"),
+     "takes a results file name ending in .h5 or without a suffix"),
+    ("run", "res.yaml", "-o res.yaml: -o takes a results file name ending in .h5 or without a "
+     "suffix (NAME.h5; one config) or a folder (an existing one, or a name ending in /)"),
     ("merge", "/dev/null", "-o /dev/null: not a regular file"),
     ("merge", "m.yaml", "-o m.yaml: -o takes a results file name ending in .h5 (or .hdf5, .nc)"),
     ("merge", "m.h5/", "-o m.h5/: a folder; -o takes a results file name ending in .h5"),
