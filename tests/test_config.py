@@ -46,12 +46,16 @@ def test_overrides_replace_photons_and_seed(small_scene):
     assert (config.photons, config.seed) == (1234, 9)
 
 
-@pytest.mark.parametrize("key, bad, override", [("photons", "many", 1234), ("seed", -1, 9)])
+@pytest.mark.parametrize("key, bad, override", [
+    ("photons", "many", 1234), ("seed", -1, 9),
+    ("seed", "5", 3), ("photons", True, 3000)])   # refused by the model's check: location ()
 def test_a_bad_value_in_the_file_is_refused_though_overridden(small_scene, key, bad, override):
-    """`photons: many` ran when --photons replaced it, the mistake in the file unsaid."""
+    """`photons: many` ran when --photons replaced it, the mistake in the file unsaid; so did
+    `seed: '5'` and `photons: yes`, whose errors (from the model's own check) have no key in
+    their location."""
     small_scene[key] = bad
     with pytest.raises(ConfigError, match=rf"^config: {key} = {bad!r}: .* \(the file's value, "
-                                          rf"which --{key} overrides, must be valid too\)$"):
+                                          r"which is overridden, must be valid too\)$"):
         load_config(small_scene, {key: override})
 
 

@@ -381,19 +381,35 @@ def load_config(source: str | Path | dict[str, Any], overrides: dict[str, Any] |
 
 def _check_overridden(values: dict[str, Any], origin: str) -> None:
     """The file's own values of the top-level keys the command line overrides (--photons,
-    --seed) are checked as well: `photons: many` is a mistake in the file whatever replaces
-    it. Validated alone (the scene's other keys missing): only these keys' errors count."""
+    --seed; load_config's overrides) are checked as well: `photons: many` is a mistake in the
+    file whatever replaces it. Validated alone (the scene's other keys missing): only these
+    keys' errors count, among them those of the model's own checks (a boolean or a quoted
+    number, `seed: '5'`), whose location is the model's, (): only these keys are there."""
     if not values:
         return
     try:
         SceneConfig.model_validate(values)
     except ValidationError as exc:
-        errors = [e for e in exc.errors() if e["loc"][:1] in {(key,) for key in values}]
+        errors = [e for e in exc.errors() if _error_key(e) in values]
         if errors:
             first, _ = _first_problem(errors)
-            key = errors[0]["loc"][0]
-            raise ConfigError(f"{origin}: {first} (the file's value, which --{key} "
-                              "overrides, must be valid too)") from None
+            raise ConfigError(f"{origin}: {first} (the file's value, which is overridden, "
+                              "must be valid too)") from None
+
+
+def _error_key(error: dict) -> str | None:
+    """The top-level key an error of SceneConfig is about: the first of its location, or, for
+    one raised by the model's own checks (location ()), the key they name in the error's
+    context (a quoted number) or at the start of its message (`photons = True: ...`)."""
+    loc = tuple(error.get("loc", ()))
+    if loc:
+        return loc[0] if isinstance(loc[0], str) else None
+    named = (error.get("ctx") or {}).get("key")
+    if not isinstance(named, str):
+        msg = error.get("msg", "")
+        msg = msg[len("Value error, "):] if msg.startswith("Value error, ") else msg
+        named = msg.split(" = ", 1)[0] if " = " in msg else None
+    return named.split("[", 1)[0].split(".", 1)[0] if named else None
 
 
 def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
