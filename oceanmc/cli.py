@@ -49,6 +49,8 @@ def _results_file(out: str, option: str = "-o", suffixes: tuple[str, ...] = RESU
     target = Path(out)
     others = f" (or {', '.join(suffixes[1:])})" if len(suffixes) > 1 else ""
     allowed = f"{what} name ending in {suffixes[0]}{others}"
+    if out == "":   # Path('') is the current folder
+        raise UsageError(f"{option} '': an empty name; {option} takes {allowed}")
     if _names_a_folder(out) or _existing(target) == "folder":
         raise UsageError(f"{option} {out}: a folder; {option} takes {allowed}")
     if _existing(target) == "other":
@@ -331,8 +333,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from .sweeps import OutputExists, SweepError, sweep
 
     source = Path(args.sweep)
-    out = _results_file(args.output, suffixes=(".nc",), what="a NetCDF file") if args.output \
-        else Path("results") / f"{source.stem}.nc"
+    out = _results_file(args.output, suffixes=(".nc",), what="a NetCDF file") \
+        if args.output is not None else Path("results") / f"{source.stem}.nc"
     problem = file_problem(source)   # a FIFO or a device is "not a regular file", not missing
     if problem:
         raise UsageError(f"{source}: {problem}")
@@ -570,9 +572,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _positive_int(text: str) -> int:
+    """A positive integer, 1e7 as well; 1.5e0 is refused (int(float()) made it 1)."""
     try:
-        value = int(float(text)) if "e" in text.lower() else int(text)
-    except (ValueError, OverflowError):  # OverflowError: 1e400, inf
+        if "e" in text.lower():
+            number = float(text)
+            if not number.is_integer():   # 1.5e0, and 1e400 (inf)
+                raise argparse.ArgumentTypeError(
+                    f"expected a positive integer, got {text!r}"
+                    + (f", which is {number:g}" if math.isfinite(number) else ""))
+            value = int(number)
+        else:
+            value = int(text)
+    except ValueError:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
@@ -589,7 +600,13 @@ def _photon_count(text: str) -> int:
     except ValueError:
         number = math.nan
     if number > MAX_PHOTONS:
-        shown = repr(text) if len(text) <= 24 else f"{number:.3g}"
+        digits = text.strip().lstrip("+").replace("_", "")
+        if len(text) <= 24:
+            shown = repr(text)
+        elif digits.isdigit():   # float() made a 400-digit integer inf
+            shown = f"{digits[:10]}... ({len(digits)} digits)"
+        else:
+            shown = f"{number:.3g}" if math.isfinite(number) else repr(text[:21] + "...")
         raise argparse.ArgumentTypeError(f"{shown} is more than {MAX_PHOTONS:.0e} photons; "
                                          f"allowed: 1 .. {MAX_PHOTONS:.0e}")
     return _positive_int(text)

@@ -100,14 +100,28 @@ def test_missing_config_and_bad_options(tmp_path):
 
 
 @pytest.mark.parametrize("photons, shown", [("1e99", "'1e99'"), ("1e400", "'1e400'"),
-                                            ("9" * 90, "1e+90")])
+                                            ("9" * 90, "9999999999... (90 digits)"),
+                                            ("9" * 400, "9999999999... (400 digits)")])
 def test_photons_above_the_limit_are_refused_in_readable_digits(tmp_path, photons, shown):
-    """--photons 1e99 was echoed back as an 80-digit integer (and 1e400 called not positive)."""
+    """--photons 1e99 was echoed back as an 80-digit integer (and 1e400 called not positive),
+    a 400-digit count as 'inf'."""
     done = oceanmc("run", "x.yaml", "--photons", photons, cwd=tmp_path)
     assert done.returncode == 2
     assert done.stderr.startswith(f"oceanmc run: error: argument --photons: {shown} is more than "
                                   "1e+13 photons; allowed: 1 .. 1e+13"), done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and len(done.stderr) < 160
+
+
+@pytest.mark.parametrize("option, value", [("--photons", "1.5e0"), ("--photons", "2.5e-1"),
+                                           ("--threads", "2.5e0")])
+def test_a_count_in_e_notation_that_is_not_whole_is_refused(tmp_path, option, value):
+    """--photons 1.5e0 ran 1 photon (int(float()) truncated it), --threads 2.5e0 2 threads."""
+    done = oceanmc("run", "x.yaml", option, value, cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.startswith(f"oceanmc run: error: argument {option}: expected a positive "
+                                  f"integer, got '{value}', which is {float(value):g} ("), \
+        done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
 
 
 def test_output_names_a_results_file_or_a_folder(tmp_path):
@@ -151,6 +165,8 @@ def test_output_without_a_suffix_is_the_results_file_with_h5_added(tmp_path, sce
     ("merge", "/dev/null", "-o /dev/null: not a regular file"),
     ("merge", "m.yaml", "-o m.yaml: -o takes a results file name ending in .h5 (or .hdf5, .nc)"),
     ("merge", "m.h5/", "-o m.h5/: a folder; -o takes a results file name ending in .h5"),
+    ("merge", "", "-o '': an empty name; -o takes a results file name ending in .h5"),
+    ("sweep", "", "-o '': an empty name; -o takes a NetCDF file name ending in .nc"),
     ("sweep", "lut.nc/", "-o lut.nc/: a folder; -o takes a NetCDF file name ending in .nc"),
     ("sweep", "/dev/null", "-o /dev/null: not a regular file")])
 def test_output_that_is_not_a_results_file_is_refused_in_one_line(tmp_path, scene_file, command,
