@@ -15,33 +15,6 @@ class ConfigError(ValueError):
     """A scene that cannot be run; the message names the key, the value and what is allowed."""
 
 
-def _admits_boolean(annotation: Any) -> bool:
-    """Whether a field may take a boolean: a bool, Any, or a Literal (whose own validator may
-    read one, as depth_splitting reads YAML's `on`), alone or in a union, through Annotated."""
-    origin = typing.get_origin(annotation)
-    if origin is Annotated:
-        return _admits_boolean(typing.get_args(annotation)[0])
-    if origin in (typing.Union, types.UnionType):
-        return any(_admits_boolean(a) for a in typing.get_args(annotation))
-    return annotation in (bool, Any) or origin is typing.Literal
-
-
-def _expected(annotation: Any) -> str:
-    """What a field takes, in words, for a message: a mapping (a group of keys), a list, or a
-    number."""
-    origin = typing.get_origin(annotation)
-    if origin is Annotated:
-        return _expected(typing.get_args(annotation)[0])
-    if origin in (typing.Union, types.UnionType):
-        given = " ".join(_expected(a) for a in typing.get_args(annotation)
-                         if a is not type(None))
-        kinds = [k for k in ("a number", "a list", "a mapping") if k in given]
-        return " or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return "a mapping"
-    return "a list" if origin in (list, tuple) else "a number"
-
-
 def _members(annotation: Any) -> list[Any]:
     """The types a value may take under an annotation: through Annotated and unions."""
     origin = typing.get_origin(annotation)
@@ -50,6 +23,26 @@ def _members(annotation: Any) -> list[Any]:
     if origin in (typing.Union, types.UnionType):
         return [m for a in typing.get_args(annotation) for m in _members(a)]
     return [annotation]
+
+
+def _admits_boolean(annotation: Any) -> bool:
+    """Whether a field may take a boolean: a bool, Any, or a Literal (whose own validator may
+    read one, as depth_splitting reads YAML's `on`), alone or in a union, through Annotated."""
+    return any(m in (bool, Any) or typing.get_origin(m) is typing.Literal
+               for m in _members(annotation))
+
+
+def _expected(annotation: Any) -> str:
+    """What a field takes, in words, for a message: a mapping (a group of keys), a list, or a
+    number (or several of them, for a union)."""
+    def kind(member: Any) -> str:
+        if isinstance(member, type) and issubclass(member, BaseModel):
+            return "a mapping"
+        return "a list" if typing.get_origin(member) in (list, tuple) else "a number"
+
+    given = {kind(m) for m in _members(annotation) if m is not type(None)} or {"a number"}
+    kinds = [k for k in ("a number", "a list", "a mapping") if k in given]
+    return " or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]
 
 
 def _string_for_a_number(value: Any, annotations: list[Any]) -> tuple[str, str] | None:
