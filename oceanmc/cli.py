@@ -42,13 +42,13 @@ def _existing(path: Path) -> str:
 
 
 def _results_file(out: str, option: str = "-o", suffixes: tuple[str, ...] = RESULT_SUFFIXES,
-                  what: str = "a results file") -> Path:
+                  what: str = "a results file", allowed: str | None = None) -> Path:
     """The file -o names where the command writes one file: a name ending in one of suffixes,
     not a folder, not a device or a FIFO (they would be replaced, or written into a name
-    beside them)."""
+    beside them). allowed: what the refusals say the option takes (default: such a name)."""
     target = Path(out)
     others = f" (or {', '.join(suffixes[1:])})" if len(suffixes) > 1 else ""
-    allowed = f"{what} name ending in {suffixes[0]}{others}"
+    allowed = allowed or f"{what} name ending in {suffixes[0]}{others}"
     if out == "":   # Path('') is the current folder
         raise UsageError(f"{option} '': an empty name; {option} takes {allowed}")
     if _names_a_folder(out) or _existing(target) == "folder":
@@ -65,29 +65,27 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
     """One results file per config: -o FILE.h5 (.hdf5, .nc) for a single config, and -o NAME
     without a suffix (not an existing folder) the file NAME.h5; -o DIR (an existing folder, a
     name ending in '/', or, for several configs, a name without a suffix, made if need be)
-    gets each file named after its config; else results/<config name>.h5. Any other -o
-    (another suffix such as .yaml, a device such as /dev/null) is refused."""
+    gets each file named after its config; else results/<config name>.h5. Any other -o (an
+    empty name, another suffix such as .yaml, a device such as /dev/null) is refused by
+    _results_file."""
     if out is None:
         return [Path("results") / f"{c.stem}.h5" for c in configs]
     target = Path(out)
-    kind = _existing(target)
-    allowed = ("a results file name ending in .h5 or without a suffix (NAME.h5; one config) "
-               "or a folder (an existing one, or a name ending in /)")
-    if out == "":
-        raise UsageError(f"-o '': an empty name; -o takes {allowed}")
+    kind = _existing(target) if out else ""
+    several = f"-o {out}: several configs need a folder for -o, not a file name"
     if kind == "folder" or _names_a_folder(out):
         return [target / f"{c.stem}.h5" for c in configs]
-    if kind == "other":
-        raise UsageError(f"-o {out}: not a regular file (a device, a FIFO or a socket); -o "
-                         f"takes {allowed}")
-    if not target.suffix and len(configs) == 1:
-        return [target.with_name(target.name + ".h5")]   # `-o name` means the file name.h5
-    if not target.suffix and kind == "":
-        return [target / f"{c.stem}.h5" for c in configs]   # several: the folder name/
-    if target.suffix and target.suffix.lower() not in RESULT_SUFFIXES:
-        raise UsageError(f"-o {out}: -o takes {allowed}")
-    if len(configs) > 1:   # a .h5 name, or an existing file without a suffix
-        raise UsageError(f"-o {out}: several configs need a folder for -o, not a file name")
+    if out and not target.suffix and kind != "other":
+        if len(configs) == 1:
+            return [target.with_name(target.name + ".h5")]   # `-o name` means the file name.h5
+        if kind == "":
+            return [target / f"{c.stem}.h5" for c in configs]   # several: the folder name/
+        raise UsageError(several)   # an existing file
+    target = _results_file(out, allowed="a results file name ending in .h5 or without a suffix "
+                           "(NAME.h5; one config) or a folder (an existing one, or a name "
+                           "ending in /)")
+    if len(configs) > 1:
+        raise UsageError(several)
     return [target]
 
 
