@@ -145,18 +145,6 @@ def test_output_names_a_results_file_or_a_folder(tmp_path):
         _outputs(two, str(tmp_path / "plain"))
 
 
-def test_output_leaves_the_checks_of_a_file_name_to_results_file(monkeypatch):
-    """One copy of the checks of a results file's name (an empty name, a device, the suffix):
-    run's -o calls merge's and sweep's _results_file for them."""
-    from oceanmc import cli
-    checked = []
-    monkeypatch.setattr(cli, "_results_file",
-                        lambda out, **kwargs: checked.append(out) or Path(out))
-    assert cli._outputs([Path("scene.yaml")], "r.h5") == [Path("r.h5")]
-    assert cli._outputs([Path("scene.yaml")], "/dev/null") == [Path("/dev/null")]
-    assert checked == ["r.h5", "/dev/null"]
-
-
 def test_output_without_a_suffix_is_the_results_file_with_h5_added(tmp_path, scene_file):
     """`-o out` writes out.h5 and a second `-o out` finds it (the file to --resume)."""
     done = oceanmc("run", scene_file, "-o", "out", "--photons", "2000", cwd=tmp_path)

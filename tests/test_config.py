@@ -193,23 +193,6 @@ def test_a_quoted_number_is_refused(tmp_path, small_scene, line, message):
                                "number without quotes)")
 
 
-def test_the_annotation_walks_are_one_helper(monkeypatch):
-    """_admits_boolean and _expected see a field's types through config.base._members, the one
-    walk through Annotated and unions (each had a copy of it)."""
-    from typing import Annotated, Literal
-
-    from oceanmc.config import base
-    walked = []
-    members = base._members
-    monkeypatch.setattr(base, "_members", lambda a: walked.append(a) or members(a))
-    number_or_name = Annotated[float | Literal["auto"] | None, "note"]
-    assert base._admits_boolean(number_or_name) and not base._admits_boolean(list[float] | None)
-    assert base._expected(Annotated[float | list[float] | None, "note"]) == "a number or a list"
-    for annotation in (number_or_name, list[float] | None,
-                       Annotated[float | list[float] | None, "note"]):
-        assert annotation in walked
-
-
 def test_a_quoted_number_is_refused_where_a_name_is_allowed_too(small_scene):
     small_scene["estimator"] = {"upward_fraction": "0.5"}   # a number, 'auto' or null
     assert _error(small_scene) == ("config: estimator.upward_fraction = '0.5': expected a "
