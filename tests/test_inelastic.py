@@ -31,7 +31,7 @@ from oceanmc.config.inelastic import (RAMAN_SHIFT_RANGE, ChlorophyllFluorescence
                                       Raman, transport_grid)
 from oceanmc.optics import column_iops
 from oceanmc.optics.illumination import illumination_spectrum
-from oceanmc.optics.inelastic import channels, transfer
+from oceanmc.optics.inelastic import channels, factors, transfer
 from oceanmc.optics.inelastic import chlorophyll_fluorescence as fluorescence
 from oceanmc.optics.inelastic import raman
 from oceanmc.validation.cases.inelastic import clear_water
@@ -348,6 +348,24 @@ def test_fluorescence_transfer_conserves_photons():
     # the emission is the 685 nm Gaussian, whatever the excitation
     lit = wl[t[int(np.argmin(np.abs(wl - 440.0)))] > 0.0]
     assert lit.min() >= 685.0 - 6 * 10.6 and lit.max() <= 685.0 + 6 * 10.6
+
+
+def test_only_the_fluorescence_transfer_is_separable():
+    """factors(): the kernel emits a separable transfer as b_i sum_j x_j a_j; only one whose
+    rows are all multiples of one row may take that way (chlorophyll fluorescence's, whose
+    emission does not depend on the excitation), not Raman's, whose lines move with it."""
+    wl = np.arange(340.0, 761.0, 10.0)
+    aph = 0.03 * np.exp(-(wl - 440.0) ** 2 / 2e4) + 0.002
+    ed0 = 1.0 + 0.3 * np.cos(wl / 37.0)                  # a source spectrum that is not flat
+    settings = ChlorophyllFluorescence()
+    sigma = fluorescence.coefficient(settings, SimpleNamespace(a_phytoplankton=aph), wl)
+    t = transfer(fluorescence, settings, wl, sigma, ed0)
+    a, b = factors(t)
+    np.testing.assert_allclose(np.outer(a, b), t, rtol=0.0, atol=1e-14 * t.max())
+    assert np.count_nonzero(b) == np.count_nonzero(t.max(axis=0))
+    t_raman = transfer(raman, Raman(), wl, raman.coefficient_at(Raman(), wl), ed0)
+    assert factors(t_raman) is None
+    assert factors(np.zeros((3, 3))) is None
 
 
 # --- 3. a short kernel run ------------------------------------------------------------------------

@@ -60,7 +60,9 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               emission's phase function (1 + beta cos^2), 0 isotropic), channel_sigma
 #               ((n_channels - 1) x n_layers x n_wl: what each takes per unit weight and
 #               length), channel_reach ((n_channels - 1) x n_wl: the row sums of its
-#               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, excitation-major)
+#               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, excitation-major),
+#               channel_factors ((n_channels - 1) x 2 x n_wl: a then b of a separable
+#               transfer, T_ji = a_j b_i; zeros for one that is not)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
@@ -70,17 +72,20 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               channel_model (n_channels: registry.CHANNEL ids; channel 0 is elastic);
 #               channel_band ((n_channels - 1) x n_wl x 2: each excitation row's emission
 #               columns first .. last - 1), channel_emits ((n_channels - 1) x 2: the columns
-#               any row emits into)
+#               any row emits into), channel_separable ((n_channels - 1): 1 where the
+#               transfer is separable, optics/inelastic factors)
 MEDIUM = _record(
     "n_planes", "n_layers", "n_wl", "n_comps", "n_channels", "up_cos",
     ints=("n_planes", "n_layers", "n_wl", "n_comps", "n_channels"),
     floats_at=("plane_z", "plane_tau", "layer_c", "layer_inv_c", "layer_albedo",
                "layer_c_over_b", "layer_settle_path", "up_fraction", "up_density", "up_keep",
                "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
-               "channel_beta", "channel_sigma", "channel_reach", "channel_transfer"),
+               "channel_beta", "channel_sigma", "channel_reach", "channel_transfer",
+               "channel_factors"),
     ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
              "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
-             "mix_comp", "mix_at", "channel_model", "channel_band", "channel_emits"))
+             "mix_comp", "mix_at", "channel_model", "channel_band", "channel_emits",
+             "channel_separable"))
 
 # The air-water surface (kernel/surface/): model id and its parameters.
 # delta: a delta BSDF (flat, none; split() applies); alpha_u, alpha_c: the facets' Beckmann

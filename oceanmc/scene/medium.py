@@ -288,6 +288,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
     if ed0 is None:
         ed0 = optics.illumination_spectrum(config)[0]
     inelastic = optics.inelastic.channels(config, layers, ed0)
+    separable = [optics.inelastic.factors(ch.transfer) for ch in inelastic]
     f, i = Pool(np.float64), Pool(np.int64)
     rec = record(
         MEDIUM, n_planes=len(plane_z), n_layers=len(layers), n_wl=n_wl,
@@ -320,7 +321,10 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         channel_reach=f.add([ch.transfer.sum(axis=1) for ch in inelastic]),
         channel_transfer=f.add([ch.transfer for ch in inelastic]),
         channel_band=i.add([optics.inelastic.band(ch.transfer) for ch in inelastic]),
-        channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]))
+        channel_emits=i.add([_emits(ch.transfer) for ch in inelastic]),
+        channel_separable=i.add([factors is not None for factors in separable]),
+        channel_factors=f.add([np.zeros(2 * n_wl) if factors is None else np.concatenate(factors)
+                               for factors in separable]))
     column = Column(surface_level, depths, level_tau, albedo, tuple(layers), windows,
                     weight_window.segment_windows(windows, layers, plane_z), upward)
     return rec, f.array(), i.array(), column

@@ -37,6 +37,10 @@ FINE_STEP_NM = 0.02
 # a transfer entry below this share of its row's largest is dropped (the Gaussian tails: Raman
 # lines at more than 6 standard deviations, which hold less than 1e-8 of the light)
 TAIL = 1e-9
+# a transfer within this share of its largest entry of a product a_j b_i is taken as that
+# product (factors): the rounding of its integral (about 1e-16) is far below it, the smallest
+# entry of a transfer that depends on the excitation (Raman's, CDOM fluorescence's) far above
+SEPARABLE_RTOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,21 @@ def transfer(process, settings, wavelengths_nm: np.ndarray, sigma_shape: np.ndar
     # row is a band the kernel reads alone (band)
     out[out < TAIL * out.max(axis=1, keepdims=True)] = 0.0
     return out
+
+
+def factors(transfer: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(a, b) with T_ji = a_j b_i to SEPARABLE_RTOL of T's largest entry, when every row is a
+    multiple of one (fluorescence's: its emission spectrum does not depend on the excitation
+    wavelength, and the tails are cut at a share of each row's largest entry, so every row
+    keeps the same columns); else None. The kernel then emits E_i = b_i sum_j x_j a_j."""
+    if transfer.size == 0 or transfer.max() <= 0.0:
+        return None
+    row, column = np.unravel_index(np.argmax(transfer), transfer.shape)
+    b = transfer[row] / transfer[row, column]
+    a = transfer[:, column].copy()
+    if np.abs(transfer - np.outer(a, b)).max() > SEPARABLE_RTOL * transfer.max():
+        return None
+    return a, b
 
 
 def band(transfer: np.ndarray) -> np.ndarray:
