@@ -240,8 +240,8 @@ def carry(medium, grid, floats, tally_row, work, ps, p, layer, cos_psi, density)
     for i in range(n):
         if added[i] > 0.0:
             after = last[i] + added[i]
-            keep[i] = last[i] / after
             per_after[i] = 1.0 / after
+            keep[i] = last[i] * per_after[i]   # (one division, not two: 1.7% of the run)
             g[i] += added[i] * per_w
             last[i] = after
         else:
