@@ -136,23 +136,18 @@ def move_all(grid, tally, share, source_at, target_at, values):
     target_at, split by the parts' shares as deposit() splits: deposit_all(-1) at the one and
     deposit_all(1) at the other, bit for bit ((-v) s = -(v s)), in one pass over the shares
     (an inelastic collision's take moves from its layer's absorption to shifted out: two
-    passes took 8.5% of the inelastic bench's run by perf)."""
+    passes took 8.5% of the inelastic bench's run by perf). A scene with inelastic light always
+    has parts, so the shares are never empty here."""
     n = grid.n_wl
-    parts = grid.n_parts if share.shape[0] > 0 else 1
     size = grid.part_size
-    for part in range(parts):
+    for part in range(grid.n_parts):
         source = tally[part * size + source_at:part * size + source_at + n]
         target = tally[part * size + target_at:part * size + target_at + n]
-        if share.shape[0] == 0:
-            for j in range(n):
-                source[j] -= values[j]
-                target[j] += values[j]
-        else:
-            part_share = share[part * n:(part + 1) * n]
-            for j in range(n):
-                moved = values[j] * part_share[j]
-                source[j] -= moved
-                target[j] += moved
+        part_share = share[part * n:(part + 1) * n]
+        for j in range(n):
+            moved = values[j] * part_share[j]
+            source[j] -= moved
+            target[j] += moved
 
 
 @internal
