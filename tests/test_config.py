@@ -201,6 +201,56 @@ def test_a_quoted_number_is_refused_where_a_name_is_allowed_too(small_scene):
     assert load_config(small_scene).estimator.upward_fraction == "auto"
 
 
+@pytest.mark.parametrize("where, written, message", [
+    (("illumination", "sun_zenith_deg"), "inf",
+     "illumination.sun_zenith_deg = inf: not a finite number; allowed: a number >= 0 and < 90"),
+    (("illumination", "sun_zenith_deg"), "-inf",
+     "illumination.sun_zenith_deg = -inf: not a finite number; allowed: a number >= 0 and < 90"),
+    (("illumination", "sun_zenith_deg"), "NaN",
+     "illumination.sun_zenith_deg = NaN: not a finite number; allowed: a number >= 0 and < 90"),
+    (("bottom", "reflectance"), "nan",
+     "bottom.reflectance = nan: not a finite number; allowed: a number 0 .. 1"),
+    (("batches",), "inf", "batches = inf: not a finite number; allowed: an integer 2 .. 100000"),
+    (("photons",), "nan", "photons = nan: not a finite number; allowed: an integer 1 .. 1e+13"),
+    (("photons",), "-inf", "photons = -inf: not a finite number; allowed: an integer 1 .. 1e+13"),
+    (("tallies", "depths_m", 1), "inf",
+     "tallies.depths_m[1] = inf: not a finite number; allowed: a number >= 0"),
+    # a key that takes .inf (an infinitely deep layer): the way to write it
+    (("water", "layers", 0, "thickness_m"), "inf",
+     "water.layers[0].thickness_m = inf: YAML reads a bare inf as text; write .inf for "
+     "infinity")])
+def test_a_bare_inf_or_nan_is_refused_as_not_finite_not_as_quoted(tmp_path, small_scene, where,
+                                                                    written, message):
+    """YAML 1.1 reads a bare inf, -inf or nan as a string: `sun_zenith_deg: inf` was refused
+    with "write the number without quotes", though no quotes were written (and `photons: nan`
+    as "unable to parse string as an integer"). The message says what is wrong and what is
+    allowed."""
+    node = small_scene
+    for step in where[:-1]:
+        node = node[step]
+    node[where[-1]] = "SENTINEL"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", written))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value) == f"{path}: {message}"
+
+
+@pytest.mark.parametrize("key, value, shown", [
+    ("sun_zenith_deg", ".inf", "inf"), ("sun_zenith_deg", ".nan", "nan"),
+    ("sun_zenith_deg", "-.inf", "-inf"), ("diffuse_fraction", ".NaN", "nan")])
+def test_yaml_infinity_and_nan_are_refused_where_a_finite_number_is_needed(
+        tmp_path, small_scene, key, value, shown):
+    """.inf and .nan, which YAML reads as floats, are refused in one line naming the key."""
+    small_scene["illumination"][key] = "SENTINEL"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", value))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value).startswith(f"{path}: illumination.{key} = {shown}: ")
+    assert "finite number" in str(info.value) and "\n" not in str(info.value)
+
+
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(
         tmp_path, small_scene):
     """YAML 1.1 (PyYAML, which reads the stored configs back) reads 1e-1 and 2.5e1 (no decimal

@@ -1,6 +1,7 @@
 """What every part of the schema shares: the error type, the strict base model, number types."""
 from __future__ import annotations
 
+import math
 import re
 import types
 import typing
@@ -45,33 +46,115 @@ def _expected(annotation: Any) -> str:
     return " or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]
 
 
-def _string_for_a_number(value: Any, annotations: list[Any]) -> tuple[str, str] | None:
-    """(where, the string) of a number given as a string where only a number is allowed
-    (`'30'`, a number quoted in the YAML; see _quoted_number), in value or the lists it holds:
-    where is '' or list indices ('[1]'); None if there is none. A member that takes the string
-    (str, Any, a Literal holding it such as 'hydrolight' or 'auto') lets it through, as does an
-    annotation without a number (a model's own checks judge what it is given)."""
+def _string_for_a_number(value: Any, annotations: list[Any]
+                         ) -> tuple[str, str, list[Any]] | None:
+    """(where, the string, the annotations it was given for) of a number given as a string
+    where only a number is allowed (`'30'`, a number quoted in the YAML; see _quoted_number),
+    in value or the lists it holds: where is '' or list indices ('[1]'); None if there is none.
+    A member that takes the string (str, Any, a Literal holding it such as 'hydrolight' or
+    'auto') lets it through, as does an annotation without a number (a model's own checks
+    judge what it is given)."""
     members = [m for a in annotations for m in _members(a)]
     if isinstance(value, str):
         takes_string = any(m in (str, Any) or (typing.get_origin(m) is typing.Literal
                                                and value in typing.get_args(m))
                            for m in members)
         numbers = any(m in (int, float) for m in members)
-        return ("", value) if numbers and not takes_string and _quoted_number(value) else None
+        return ("", value, annotations) \
+            if numbers and not takes_string and _quoted_number(value) else None
     if isinstance(value, (list, tuple)):
-        items = [a for m in members if typing.get_origin(m) in (list, tuple)
-                 for a in typing.get_args(m) if a is not Ellipsis]
-        if not items:
+        sequences = [m for m in members if typing.get_origin(m) in (list, tuple)]
+        if not sequences:
             return None
         for i, item in enumerate(value):
-            found = _string_for_a_number(item, items)
+            found = _string_for_a_number(item, [a for m in sequences for a in _items(m, i)])
             if found is not None:
-                return f"[{i}]{found[0]}", found[1]
+                return f"[{i}]{found[0]}", found[1], found[2]
     return None
+
+
+def _items(sequence: Any, i: int) -> list[Any]:
+    """The annotations item i of a list or tuple annotation may take: a list's item type, a
+    fixed tuple's i-th (tuple[float, float]: one per position)."""
+    args = typing.get_args(sequence)
+    if typing.get_origin(sequence) is tuple and Ellipsis not in args:
+        return [args[i]] if i < len(args) else []
+    return [a for a in args if a is not Ellipsis]
+
+
+def _numbers(annotation: Any, metadata: tuple = ()) -> list[tuple[type, tuple]]:
+    """(int or float, its constraints: annotated_types' Ge, Gt, Le, Lt, AllowInfNan) of each
+    number a value may be under an annotation, through Annotated (and a Field() in it) and
+    unions; lists, models and names are left out."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        inner, *extra = typing.get_args(annotation)
+        found = [c for m in extra for c in (getattr(m, "metadata", None) or [m])]
+        return _numbers(inner, metadata + tuple(found))
+    if origin in (typing.Union, types.UnionType):
+        return [n for a in typing.get_args(annotation) for n in _numbers(a, metadata)]
+    return [(annotation, metadata)] if annotation in (int, float) else []
+
+
+def _bound(value: float) -> str:
+    return str(int(value)) if value == int(value) and abs(value) < 1e6 else f"{value:.6g}"
+
+
+def _allowed_number(kind: type, constraints: tuple) -> str:
+    """`a number >= 0 and < 90`, `an integer 2 .. 100000`, `a number 0 .. 1`."""
+    get = {name: getattr(c, name) for c in constraints for name in ("ge", "gt", "le", "lt")
+           if getattr(c, name, None) is not None}
+    what = "an integer" if kind is int else "a number"
+    if kind is int:   # > 0 is >= 1
+        get |= {"ge": get.pop("gt") + 1} if "gt" in get else {}
+        get |= {"le": get.pop("lt") - 1} if "lt" in get else {}
+    if "ge" in get and "le" in get:
+        return f"{what} {_bound(get['ge'])} .. {_bound(get['le'])}"
+    parts = [f"{sign} {_bound(get[name])}" for name, sign in
+             (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")) if name in get]
+    if not parts:
+        return "a finite number" if kind is float else what
+    return f"{what} {' and '.join(parts)}"
+
+
+def _admits_infinity(kind: type, constraints: tuple, sign: float) -> bool:
+    """Whether a number of this kind and these constraints may be +inf (sign 1) or -inf (-1)."""
+    bounds = ("le", "lt") if sign > 0 else ("ge", "gt")
+    return kind is float and not any(getattr(c, "allow_inf_nan", True) is False
+                                     or any(getattr(c, b, None) is not None for b in bounds)
+                                     for c in constraints)
+
+
+_NON_FINITE_WORD = re.compile(r"^\s*[-+]?(?:inf|infinity|nan)\s*$", re.IGNORECASE)
+
+
+def non_finite_text(text: str, annotations: list[Any]) -> str | None:
+    """What is wrong with `inf`, `-inf` or `nan` (YAML 1.1 reads them bare as strings; .inf
+    and .nan are its infinity and NaN) given for a number, and what is allowed; None for any
+    other string. Where the key takes infinity (a layer's thickness_m), the way to write it."""
+    if not _NON_FINITE_WORD.match(text):
+        return None   # (1e400, which float() makes inf, is a number beyond the range)
+    number = float(text)
+    numbers = [n for a in annotations for n in _numbers(a)]
+    if math.isinf(number) and any(_admits_infinity(*n, number) for n in numbers):
+        return (f"YAML reads a bare {text} as text; write {'-' if number < 0 else ''}.inf for "
+                "infinity")
+    allowed = " or ".join(dict.fromkeys(_allowed_number(*n) for n in numbers)) or \
+        "a finite number"
+    return f"not a finite number; allowed: {allowed}"
 
 
 # the type of the error for a number given as a string (config/loading.py _describe)
 QUOTED_NUMBER = "quoted_number"
+# and for inf, -inf or nan given for a number (strings, to YAML 1.1): its context holds the
+# value as written, what is wrong with it and, raised for a model, the key below its path
+NON_FINITE = "non_finite_number"
+
+
+def non_finite_error(text: str, problem: str, key: str | None = None) -> PydanticCustomError:
+    context = {"value": text, "problem": problem} | ({"key": key} if key is not None else {})
+    return PydanticCustomError(NON_FINITE, ("{key} = " if key is not None else "")
+                               + "{value}: {problem}", context)
 
 
 class _Strict(BaseModel):
@@ -98,8 +181,11 @@ class _Strict(BaseModel):
                 # number. Other strings are left to pydantic's message, as is a field whose own
                 # validator reads strings (photons' '1e6'). The error's type tells
                 # config/loading.py to name the key below the model's path
-                found = _string_for_a_number(value, [field.annotation]) \
+                found = _string_for_a_number(value, [field.rebuild_annotation()]) \
                     if field is not None and name not in cls._reads_strings() else None
+                problem = non_finite_text(found[1], found[2]) if found is not None else None
+                if problem is not None:   # `a: inf`, unquoted: not a quoted number
+                    raise non_finite_error(found[1], problem, f"{name}{found[0]}")
                 if found is not None:
                     raise PydanticCustomError(
                         QUOTED_NUMBER, "{key} = {value!r}: expected a number, got a string",

@@ -8,7 +8,7 @@ import numpy as np
 
 from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from .base import _Strict
+from .base import _Strict, non_finite_error, non_finite_text
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
                      check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
@@ -71,6 +71,9 @@ class SceneConfig(_Strict):
                 number = float(value)
             except ValueError:
                 return value
+            problem = non_finite_text(value, [cls.model_fields["photons"].rebuild_annotation()])
+            if problem is not None:   # `photons: nan`, which YAML 1.1 reads as text
+                raise non_finite_error(value, problem)
             value = number if math.isfinite(number) else value
         if isinstance(value, float) and math.isfinite(value) and value == int(value):
             if abs(value) > MAX_PHOTONS:   # else shown as the 309 digits of int(1e308)
