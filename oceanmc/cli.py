@@ -591,20 +591,15 @@ def _positive_int(text: str) -> int:
 def _photon_count(text: str) -> int:
     """--photons: a positive integer (1e7 as well) of at most the largest count a scene takes
     (config.scene.MAX_PHOTONS), refused in readable digits: int('1e99') has 100."""
-    from .config.scene import MAX_PHOTONS   # here: --help does not import the schema
+    # (here: --help does not import the schema)
+    from .config.scene import MAX_PHOTONS, readable_count
 
     try:
         number = float(text)   # 1e400 and a 400-digit integer: inf
     except ValueError:
         number = math.nan
     if number > MAX_PHOTONS:
-        digits = text.strip().lstrip("+").replace("_", "")
-        if len(text) <= 24:
-            shown = repr(text)
-        elif digits.isdigit():   # float() made a 400-digit integer inf
-            shown = f"{digits[:10]}... ({len(digits)} digits)"
-        else:
-            shown = f"{number:.3g}" if math.isfinite(number) else repr(text[:21] + "...")
+        shown = repr(text) if len(text) <= 24 else readable_count(text)
         raise argparse.ArgumentTypeError(f"{shown} is more than {MAX_PHOTONS:.0e} photons; "
                                          f"allowed: 1 .. {MAX_PHOTONS:.0e}")
     return _positive_int(text)

@@ -251,6 +251,25 @@ def test_yaml_infinity_and_nan_are_refused_where_a_finite_number_is_needed(
     assert "finite number" in str(info.value) and "\n" not in str(info.value)
 
 
+def test_a_photon_count_beyond_the_limit_is_shown_in_readable_digits(tmp_path, small_scene):
+    """`photons: 100000000000000000000` (an integer to YAML) was refused as pydantic's `photons
+    = 100000000000000000000: Input should be less than or equal to 10000000000000`: every digit
+    of the value and of the limit. Shown as the float forms are (`photons = 1e+308: allowed: 1
+    .. 1e+13`), and as `--photons` shows one (cli.py, config.scene.readable_count)."""
+    small_scene["photons"] = "SENTINEL"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", "100000000000000000000"))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value) == f"{path}: photons = 1e+20: allowed: 1 .. 1e+13"
+    for value, shown in ((-10**20, "-1e+20"), (10**400, "1000000000... (401 digits)"),
+                         (10**5000, "an integer of more than 4300 digits")):
+        small_scene["photons"] = value
+        assert _error(small_scene) == f"config: photons = {shown}: allowed: 1 .. 1e+13"
+    small_scene["photons"] = 10**13   # the limit itself loads
+    assert load_config(small_scene).photons == 10**13
+
+
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(
         tmp_path, small_scene):
     """YAML 1.1 (PyYAML, which reads the stored configs back) reads 1e-1 and 2.5e1 (no decimal

@@ -146,14 +146,15 @@ def non_finite_text(text: str, annotations: list[Any]) -> str | None:
 
 # the type of the error for a number given as a string (config/loading.py _describe)
 QUOTED_NUMBER = "quoted_number"
-# and for inf, -inf or nan given for a number (strings, to YAML 1.1): its context holds the
-# value as written, what is wrong with it and, raised for a model, the key below its path
-NON_FINITE = "non_finite_number"
+# and for a value shown otherwise than as pydantic's repr of the input: inf or nan as written
+# (strings, to YAML 1.1, not quoted), a 21-digit photon count as 1e+20. Its context holds the
+# value as shown, what is wrong with it and, raised for a model, the key below its path
+SHOWN_VALUE = "shown_value"
 
 
-def non_finite_error(text: str, problem: str, key: str | None = None) -> PydanticCustomError:
-    context = {"value": text, "problem": problem} | ({"key": key} if key is not None else {})
-    return PydanticCustomError(NON_FINITE, ("{key} = " if key is not None else "")
+def shown_value_error(shown: str, problem: str, key: str | None = None) -> PydanticCustomError:
+    context = {"value": shown, "problem": problem} | ({"key": key} if key is not None else {})
+    return PydanticCustomError(SHOWN_VALUE, ("{key} = " if key is not None else "")
                                + "{value}: {problem}", context)
 
 
@@ -185,7 +186,7 @@ class _Strict(BaseModel):
                     if field is not None and name not in cls._reads_strings() else None
                 problem = non_finite_text(found[1], found[2]) if found is not None else None
                 if problem is not None:   # `a: inf`, unquoted: not a quoted number
-                    raise non_finite_error(found[1], problem, f"{name}{found[0]}")
+                    raise shown_value_error(found[1], problem, f"{name}{found[0]}")
                 if found is not None:
                     raise PydanticCustomError(
                         QUOTED_NUMBER, "{key} = {value!r}: expected a number, got a string",

@@ -16,7 +16,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
-from .base import NON_FINITE, QUOTED_NUMBER, ConfigError
+from .base import QUOTED_NUMBER, SHOWN_VALUE, ConfigError
 from .bottom import ReflectanceSpectrum, TableBottom, reflectance_keys
 from .illumination import SkyMap
 from .phase import Mixture, TablePhase
@@ -271,7 +271,7 @@ def _describe(error: dict) -> str:
     msg = error.get("msg", "invalid")
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
-    if kind == NON_FINITE:   # `inf` or `nan` (a string): raised for the model or for the key
+    if kind == SHOWN_VALUE:   # (`inf` as written, 1e+20): raised for the model or for the key
         where = path if "key" not in ctx else \
             ("" if path == "(top level)" else f"{path}.") + ctx["key"]
         return f"{where} = {ctx['value']}: {ctx['problem']}"

@@ -8,7 +8,7 @@ import numpy as np
 
 from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from .base import _Strict, non_finite_error, non_finite_text
+from .base import _Strict, non_finite_text, shown_value_error
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
                      check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
@@ -20,6 +20,21 @@ from .water import Water
 from .wavelengths import Wavelengths, check_increasing, grid
 
 MAX_PHOTONS = 10**13
+
+
+def readable_count(text: str) -> str:
+    """A count beyond MAX_PHOTONS as a message shows it: a long integer by its first digits and
+    how many there are (`9999999999... (400 digits)`, which float() makes inf), else in 3
+    significant digits (`1e+20`, not 21 digits), else as written, cut (`photons` in the scene
+    and `--photons` alike)."""
+    digits = text.strip().lstrip("+").replace("_", "")
+    if digits.isdigit() and len(digits) > 24:
+        return f"{digits[:10]}... ({len(digits)} digits)"
+    try:
+        number = float(text)
+    except ValueError:
+        number = math.nan
+    return f"{number:.3g}" if math.isfinite(number) else repr(text[:21] + "...")
 
 
 def _listed(wavelengths: list[float]) -> str:
@@ -73,12 +88,18 @@ class SceneConfig(_Strict):
                 return value
             problem = non_finite_text(value, [cls.model_fields["photons"].rebuild_annotation()])
             if problem is not None:   # `photons: nan`, which YAML 1.1 reads as text
-                raise non_finite_error(value, problem)
+                raise shown_value_error(value, problem)
             value = number if math.isfinite(number) else value
         if isinstance(value, float) and math.isfinite(value) and value == int(value):
             if abs(value) > MAX_PHOTONS:   # else shown as the 309 digits of int(1e308)
                 raise ValueError(f"allowed: 1 .. {MAX_PHOTONS:.0e}")
             return int(value)
+        if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_PHOTONS:
+            try:   # (pydantic's message had every digit of the value and of the limit)
+                shown = "-" * (value < 0) + readable_count(str(abs(value)))
+            except ValueError:   # str() of an integer of more than 4300 digits
+                shown = "an integer of more than 4300 digits"
+            raise shown_value_error(shown, f"allowed: 1 .. {MAX_PHOTONS:.0e}")
         return value
 
     @model_validator(mode="after")
