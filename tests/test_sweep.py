@@ -155,6 +155,28 @@ def test_an_axis_may_have_a_short_name(tmp_path):
     assert again.axes == spec.axes
 
 
+def test_an_axis_of_exponent_numbers_is_a_numeric_coordinate(tmp_path):
+    """YAML 1.1 (PyYAML) reads 1e-2 and 5e-1 (no decimal point) as strings: an axis written
+    with them became a text coordinate of the dataset (a zip group's mixed [1e-1, 0.2] one of
+    YAML texts), and {geomspace: [1e-1, 4e-1, 3]} was refused as not numbers. They are the
+    numbers, as in a scene."""
+    from oceanmc.sweeps.dataset import assemble
+
+    path = sweep_file(tmp_path, {
+        "water.layers[0].a": ["1e-2", "2e-2"],
+        "zip": {"bottom.reflectance": ["1e-1", 0.2],
+                "g": {"key": "water.layers[0].phase.g", "values": ["5e-1", "8e-1"]}},
+        "water.layers[0].b": {"geomspace": ["1e-1", "4e-1", 3]}})
+    text = path.read_text()
+    assert "- 1e-2\n" in text and "- 1e-1\n" in text and "- 4e-1\n" in text   # unquoted
+    spec = load_sweep(path)
+    dataset = assemble(spec, build_points(spec), {}, {})
+    for name, values in (("water.layers[0].a", [0.01, 0.02]), ("bottom.reflectance", [0.1, 0.2]),
+                         ("g", [0.5, 0.8]), ("water.layers[0].b", [0.1, 0.2, 0.4])):
+        assert dataset[name].dtype == np.float64, name
+        assert dataset[name].values == pytest.approx(values), name
+
+
 @pytest.mark.parametrize("axes, message", [
     ({"depth": {"key": "water.layers[0].thickness_m", "values": [1, 2]}},
      "depth: the name is taken by the sweep dataset's own"),

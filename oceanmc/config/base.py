@@ -250,6 +250,18 @@ def _quoted_number(text: str) -> bool:
     return not (_EXPONENT_NUMBER.match(text) and unquoted == "tag:yaml.org,2002:str")
 
 
+def exponent_number(value: Any) -> Any:
+    """The number of a string that PyYAML (YAML 1.1) makes of an unquoted exponent number
+    (1e-3, 2.5e3, 1e6: see _quoted_number), as the float; any other value as it is. For values
+    read without a schema to judge them (a sweep's axes), where pydantic would read the string
+    as the number. The same limitation: a quoted '1e-3' is read as the number too."""
+    if isinstance(value, str) and _EXPONENT_NUMBER.match(value) and \
+            _YAML_RESOLVER.resolve(yaml.ScalarNode, value, (True, False)) == \
+            "tag:yaml.org,2002:str":
+        return float(value)
+    return value
+
+
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 # The narrowest theta band accepted (deg): its 1 - cos, 1.5e-10, is resolved by float64
 # direction cosines (spacing 1.1e-16 below 1) to 1e-6 relative; 1 - cos(1e-6 deg) = 1.5e-16 is not.

@@ -26,6 +26,7 @@ import numpy as np
 import yaml
 
 from ..config import ConfigError
+from ..config.base import exponent_number
 
 # a key, then any number of [index]: `layers[0]`, `components[-1]`, `bottom`
 _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d+\])*)$")
@@ -410,12 +411,20 @@ def _check_distinct(axis: Axis) -> None:
 
 def _values(key: str, values: Any) -> tuple[Any, ...]:
     """A list as written, or {linspace: [start, stop, num]} / {geomspace: [start, stop, num]}
-    (numpy's, end points included)."""
+    (numpy's, end points included). An exponent number that YAML 1.1 reads as a string (1e-3,
+    5e2: no decimal point, or no sign on the exponent) is the number: a text coordinate
+    otherwise."""
     if isinstance(values, dict):
         if len(values) != 1 or next(iter(values)) not in GENERATORS:
             raise SweepError(f"axes: {key} = {values!r}: expected a list of values or one of "
                              f"{', '.join(f'{{{g}: [start, stop, num]}}' for g in GENERATORS)}")
         (kind, args), = values.items()
+        if isinstance(args, list):
+            numbers = [exponent_number(a) for a in args]
+            if len(args) == 3 and isinstance(args[2], str) and isinstance(numbers[2], float) \
+                    and numbers[2].is_integer():
+                numbers[2] = int(numbers[2])   # num written 1e3
+            args = numbers
         if not (isinstance(args, list) and len(args) == 3
                 and all(isinstance(a, (int, float)) and not isinstance(a, bool) for a in args)
                 and isinstance(args[2], int) and args[2] >= 1
@@ -432,7 +441,7 @@ def _values(key: str, values: Any) -> tuple[Any, ...]:
         return tuple(float(v) for v in grid)
     if not isinstance(values, list) or not values:
         raise SweepError(f"axes: {key} = {values!r}: expected a non-empty list of values")
-    return tuple(values)
+    return tuple(exponent_number(v) for v in values)
 
 
 def coordinate(values: tuple[Any, ...]) -> np.ndarray:
