@@ -234,6 +234,36 @@ def test_a_bad_value_under_set_is_named_as_the_sweep_file_gives_it(tmp_path, set
     assert "\n" not in str(info.value) and "more point" not in str(info.value)
 
 
+def test_a_table_file_under_set_that_cannot_be_read_is_named_as_set(tmp_path):
+    """A table file given under `set:` that is missing or malformed (found when each point's
+    scene is built, after the schema) was blamed on the first point, `point (water.layers[0].a
+    = 0.1): BRDF table ...: no such file (and 1 more point)`, as if an axis were wrong; now the
+    message names `set:` and the file's key. A file an axis gives is still its point's."""
+    (tmp_path / "bad.csv").write_text("garbage\n1,2\n")
+    (tmp_path / "phase.csv").write_text("0,10\n10,1\n90,0.1\n180,0.1\n")
+    axes = {"water.layers[0].a": [0.1, 0.2]}
+    table_phase = copy.deepcopy(TINY)
+    table_phase["water"]["layers"][0]["phase"] = {"model": "table", "file": "phase.csv"}
+    for base, settings, start in (
+            (TINY, {"bottom": {"model": "table", "file": "missing.csv"}},
+             f"set: bottom.file: BRDF table {tmp_path / 'missing.csv'}: no such file"),
+            (TINY, {"water.layers[0].phase": {"model": "table", "file": "bad.csv"}},
+             f"set: water.layers[0].phase.file: phase table {tmp_path / 'bad.csv'}: "),
+            (table_phase, {"water.layers[0].phase.file": "missing.csv"},
+             f"set: water.layers[0].phase.file: phase table {tmp_path / 'missing.csv'}: ")):
+        with pytest.raises(SweepError) as info:
+            oceanmc.sweeps.prepare(sweep_file(tmp_path, axes, base=base, set=settings),
+                                   tmp_path / "lut.points")
+        assert str(info.value).startswith(start), str(info.value)
+        assert "point" not in str(info.value) and "\n" not in str(info.value)
+    settings = {"water.layers[0].phase": {"model": "table", "file": "phase.csv"}}
+    with pytest.raises(SweepError, match=r"^point \(water\.layers\[0\]\.phase\.file = "
+                       r"missing\.csv\): phase table .*missing\.csv: no such file$"):
+        oceanmc.sweeps.prepare(sweep_file(tmp_path, {"water.layers[0].phase.file": [
+            "phase.csv", "missing.csv"]}, set=settings), tmp_path / "lut.points")
+    assert not (tmp_path / "lut.points").exists()
+
+
 def test_repeated_axis_values_and_too_many_batch_groups_are_refused_before_any_run(tmp_path):
     """A value given twice on an axis (the dataset's coordinate would hold it twice, and
     selecting it return two points), and batch_groups beyond what a point's batches allow

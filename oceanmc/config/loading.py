@@ -416,7 +416,7 @@ def _error_key(error: dict) -> str | None:
     return named.split("[", 1)[0].split(".", 1)[0] if named else None
 
 
-def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
+def data_file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
     """(model, attribute, key path) of every data file the scene names: phase, component,
     profile and spectrum tables, the bottom's BRDF table and reflectance spectra, the sky
     map."""
@@ -450,7 +450,7 @@ def _file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
 def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:
     """Table files are relative to the config file's folder; they are checked when the scene is
     built (oceanmc/scene.py), which reports the file and the problem."""
-    for model, attribute, key in _file_fields(config):
+    for model, attribute, key in data_file_fields(config):
         path = getattr(model, attribute)
         try:
             resolved = (base_dir / path).resolve()
@@ -464,7 +464,7 @@ def data_file_hashes(config: SceneConfig) -> str:
     """JSON {path: sha256 of its content} of every data file the scene names: the stored config
     holds only the paths, so merge and resume compare these to refuse an edited table."""
     hashes = {}
-    for model, attribute, _ in _file_fields(config):
+    for model, attribute, _ in data_file_fields(config):
         path = getattr(model, attribute)
         digest = hashlib.sha256()
         try:   # not blocking on a FIFO, nor reading a device such as /dev/zero forever

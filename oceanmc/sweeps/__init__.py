@@ -75,7 +75,7 @@ def prepare(source: str | Path | dict, store_folder: Path, batch_groups: int | N
     # compiles here, once, a variant that every point runs on, into the disk cache that local
     # workers load from
     variant = ready(union(predicted_variant(point.config) for point in points), should_stop)[1]
-    check_scenes(points)
+    check_scenes(points, spec)
     store = PointStore(store_folder)
     plan = Plan(spec, points, store, variant)
     for point in points:

@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
+from ..config.loading import data_file_fields
 from .axes import SweepError, SweepSpec
 
 
@@ -96,18 +97,40 @@ def check_batch_groups(groups: int, points: list[Point]) -> None:
                 "batches")
 
 
-def check_scenes(points: list[Point]) -> None:
+def check_scenes(points: list[Point], spec: SweepSpec | None = None) -> None:
     """Packs every point's scene (which reads and checks its table files, BRDF checks and
-    tables: ConfigError) without tracing a photon. Needs the compiled kernel (run.compiling)."""
+    tables: ConfigError) without tracing a photon. Needs the compiled kernel (run.compiling).
+    spec: the sweep, whose `set:` a problem of a table file it gives is blamed on (as
+    build_points blames it for a value the schema refuses)."""
     from .. import scene
+    given = dict(spec.points()) if spec is not None else {}
     bad = []
+    from_set: list[str] = []
     for point in points:
         try:
             scene.build(point.config)
         except ConfigError as exc:
-            bad.append(f"point ({point.label}): {_without_origin(exc)}")
+            text = _without_origin(exc)
+            keys = _file_keys(text, point.config)
+            # (`KEY:`: a file's key path is a problem at that key)
+            if spec is not None and keys and all(
+                    _set_by(f"{key}:", spec.settings)
+                    and not _set_by(f"{key}:", dict(given[point.index])) for key in keys):
+                text = text if _set_by(text, dict.fromkeys(keys)) else f"{keys[0]}: {text}"
+                from_set.append(text)
+                text = f"set: {text}"
+            bad.append(f"point ({point.label}): {text}")
+    if bad and len(from_set) == len(points) and len(set(from_set)) == 1:
+        raise SweepError(f"set: {from_set[0]}")   # every point: the set's file alone
     if bad:
         _raise_first(bad)
+
+
+def _file_keys(problem: str, config: SceneConfig) -> list[str]:
+    """The key paths of the scene's data files a problem of building it is about: the file its
+    message names (`BRDF table PATH: no such file`, `KEY.file: PATH: ...`)."""
+    return [key for model, attribute, key in data_file_fields(config)
+            if f"{getattr(model, attribute)}:" in problem]
 
 
 def _set_by(problem: str, values: dict) -> bool:
