@@ -270,6 +270,23 @@ def test_a_photon_count_beyond_the_limit_is_shown_in_readable_digits(tmp_path, s
     assert load_config(small_scene).photons == 10**13
 
 
+def test_an_integer_of_more_than_4300_digits_is_refused_in_one_line(tmp_path, small_scene):
+    """Python (3.11+) will not turn an integer of more than 4300 digits into text or back:
+    one in a scene file was a ValueError traceback from PyYAML's int(), one in a dict (seed) a
+    ValueError from the message's repr()."""
+    small_scene["photons"] = "SENTINEL"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", "9" * 5000))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value).startswith(f"{path}: not valid for a scene: line ")
+    assert str(info.value).endswith(": an integer of 5000 digits; allowed: at most 4300 digits")
+    small_scene["photons"] = 20000
+    small_scene["seed"] = 10**5000
+    assert _error(small_scene) == ("config: seed = an integer of more than 4300 digits: Input "
+                                   "should be less than 9223372036854775808")
+
+
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(
         tmp_path, small_scene):
     """YAML 1.1 (PyYAML, which reads the stored configs back) reads 1e-1 and 2.5e1 (no decimal

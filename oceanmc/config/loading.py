@@ -7,6 +7,7 @@ import hashlib
 import json
 import os
 import stat
+import sys
 import textwrap
 import types
 from pathlib import Path
@@ -81,6 +82,25 @@ class _SceneLoader(yaml.SafeLoader):
                     None, None, f"key {key!r} given twice", mark)
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
+
+
+class _LongInteger(Exception):
+    """An integer of more digits than Python turns text into (sys.get_int_max_str_digits)."""
+
+    def __init__(self, node: yaml.Node) -> None:
+        super().__init__()
+        self.mark = node.start_mark
+        self.digits = sum(c.isdigit() for c in node.value)
+
+
+def _construct_int(loader: yaml.SafeLoader, node: yaml.Node) -> int:
+    try:
+        return yaml.SafeLoader.construct_yaml_int(loader, node)
+    except ValueError:   # (PyYAML's int() of 4301 digits or more)
+        raise _LongInteger(node) from None
+
+
+_SceneLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)
 
 
 class _RecursiveAlias(Exception):
@@ -188,7 +208,13 @@ def _parse_yaml(text: str, origin: str, kind: str = "scene") -> Any:
             if too_many:
                 raise ConfigError(f"{origin}: its aliases expand to more than "
                                   f"{MAX_YAML_NODES:,} values; a {kind} needs far fewer")
-            return loader.construct_document(node)
+            try:
+                return loader.construct_document(node)
+            except _LongInteger as exc:
+                at = f"line {exc.mark.line + 1}, column {exc.mark.column + 1}"
+                raise ConfigError(f"{origin}: not valid for a {kind}: {at}: an integer of "
+                                  f"{exc.digits} digits; allowed: at most "
+                                  f"{sys.get_int_max_str_digits()} digits") from None
         finally:
             loader.dispose()
     except yaml.MarkedYAMLError as exc:
@@ -264,6 +290,15 @@ def _model_of(annotation: Any, loc: tuple) -> Any:
     return candidates[0] if len(candidates) == 1 else None
 
 
+def _shown(value: Any) -> str:
+    """repr(value), except for an integer too long for it (more than 4300 digits: a
+    ValueError)."""
+    try:
+        return repr(value)
+    except ValueError:
+        return f"an integer of more than {sys.get_int_max_str_digits()} digits"
+
+
 def _describe(error: dict) -> str:
     path = _key_path(tuple(error.get("loc", ())))
     kind = error.get("type", "")
@@ -292,7 +327,7 @@ def _describe(error: dict) -> str:
     if path == "(top level)" and kind == "value_error":
         return msg
     if "input" in error and not isinstance(error["input"], dict):
-        shown = repr(error["input"])
+        shown = _shown(error["input"])
         if len(shown) > 80:
             shown = shown[:77] + "..."
         return f"{path} = {shown}: {msg}"
@@ -331,7 +366,7 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
             text = "a number " + text
         if text not in allowed:
             allowed.append(text)
-    shown = repr(first["input"]) if "input" in first else "this value"
+    shown = _shown(first["input"]) if "input" in first else "this value"
     if len(shown) > 80:
         shown = shown[:77] + "..."
     return f"{path} = {shown}: allowed: {' or '.join(allowed)}", len(members)
