@@ -41,13 +41,11 @@ def lut_sweep(photons: int) -> dict:
 
 
 def main(out_dir: Path, quick: bool = False) -> int:
-    import logging
-
     import numba
-    from distributed import Client, LocalCluster
 
     from .. import __version__, simulate, sweep
     from ..sweeps import load_sweep
+    from ..sweeps.execute import local_client
     from ..sweeps.points import build_points
 
     photons = 4000 if quick else 100_000
@@ -74,9 +72,7 @@ def main(out_dir: Path, quick: bool = False) -> int:
     for workers in (1, 2):
         say(f"sweep on {workers} worker process(es) ...")
         t0 = time.perf_counter()
-        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          host="127.0.0.1", dashboard_address=None,
-                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        with local_client(workers) as client:
             client.wait_for_workers(workers)
             started = time.perf_counter() - t0
             with tempfile.TemporaryDirectory() as tmp:

@@ -79,11 +79,9 @@ def run_part(scene_yaml: str, first_batch: int, threads: int | None, save_to: st
 @contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None, client=None):
     """A distributed.Client: the one given, one connected to `scheduler` (tcp://HOST:PORT), or
-    one with its own local cluster of `workers` processes (default: the number of cores) with
-    one task at a time each, listening on 127.0.0.1 only."""
-    import logging
-
-    from distributed import Client, LocalCluster
+    one with its own local cluster (local_client) of `workers` processes (default: the number
+    of cores)."""
+    from distributed import Client
     if client is not None:
         yield client
         return
@@ -91,11 +89,25 @@ def dask_client(workers: int | None = None, scheduler: str | None = None, client
         with Client(scheduler, timeout="30s") as connected:
             yield connected
         return
-    n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
-            Client(cluster) as local:
+    with local_client(workers or os.cpu_count() or 1) as local:
         yield local
+
+
+@contextmanager
+def local_client(workers: int):
+    """A Client of a local cluster of `workers` processes with one task at a time each,
+    listening on 127.0.0.1 only. Its dashboard is off; the scheduler's other HTTP routes
+    (health, metrics) listen on a free port of 127.0.0.1: left to distributed, they took port
+    8787 of every interface, and where a user's own Dask dashboard held it, distributed warned
+    'Port 8787 is already in use' (a UserWarning, which `-W error` makes a failed start)."""
+    import logging
+
+    from distributed import Client, LocalCluster
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                      host="127.0.0.1", dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        yield client
 
 
 def run_points(client, store: PointStore, todo: list[Point], groups: int, threads: int | None,
