@@ -4,6 +4,7 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from conftest import REPO
@@ -191,3 +192,32 @@ def test_deep_section_reports_gains_and_the_target():
     # 120 m lies past the first level at or below 10 attenuation depths: not counted
     assert "with windows: **met**; the worst is Eou at 100 m, 59 s." in text
     assert "Kernel commit abc1234." in text
+
+
+def test_inelastic_section_combines_the_repeats(monkeypatch):
+    """Each row of the inelastic section (`oceanmc bench --inelastic`): the value is the mean
+    over the repeats and the relative error the root of their mean square (it was the first
+    repeat's alone), the time to 1% the median time times (rel / 1%)^2."""
+    from oceanmc.bench import inelastic
+
+    calls = []
+
+    def run(config):
+        calls.append(config)
+        k = len(calls)   # 1, 2, 3 ... in the order the runs are made
+        return 2.0 * k, {"Rrs(550)": (0.001 * k, 0.01 * k)}
+
+    monkeypatch.setattr(inelastic, "_run", run)
+    monkeypatch.setattr(inelastic, "simulate", lambda *args, **kwargs: None)
+    monkeypatch.setattr(inelastic, "spread", lambda quick, say: [])
+    monkeypatch.setattr(inelastic, "RUNS", inelastic.RUNS[:2])
+    data = inelastic.measure(quick=False, say=lambda text: None)
+    assert data["repeats"] == 3 and len(calls) == 6
+    for index, run_data in enumerate(data["runs"]):
+        ks = np.array([index + 1, index + 3, index + 5])   # the run's repeats, interleaved
+        row = run_data["rows"]["Rrs(550)"]
+        assert row["value"] == pytest.approx(0.001 * ks.mean())
+        assert row["rel"] == pytest.approx(0.01 * np.sqrt(np.mean(ks ** 2)))
+        t = float(np.median(2.0 * ks))
+        assert run_data["time_s"] == pytest.approx(t)
+        assert row["time_to_target_s"] == pytest.approx(t * (row["rel"] / 0.01) ** 2)
