@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 import types
 import typing
 from typing import Annotated, Any
@@ -142,6 +143,12 @@ def non_finite_text(text: str, annotations: list[Any]) -> str | None:
     allowed = " or ".join(dict.fromkeys(_allowed_number(*n) for n in numbers)) or \
         "a finite number"
     return f"not a finite number; allowed: {allowed}"
+
+
+def too_long_integer() -> str:
+    """How a message shows an integer that str() and repr() refuse (more digits than
+    sys.get_int_max_str_digits(), 4300 by default: a ValueError)."""
+    return f"an integer of more than {sys.get_int_max_str_digits()} digits"
 
 
 # the type of the error for a number given as a string (config/loading.py _describe)

@@ -17,7 +17,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
-from .base import QUOTED_NUMBER, SHOWN_VALUE, ConfigError
+from .base import QUOTED_NUMBER, SHOWN_VALUE, ConfigError, too_long_integer
 from .bottom import ReflectanceSpectrum, TableBottom, reflectance_keys
 from .illumination import SkyMap
 from .phase import Mixture, TablePhase
@@ -296,7 +296,7 @@ def _shown(value: Any) -> str:
     try:
         return repr(value)
     except ValueError:
-        return f"an integer of more than {sys.get_int_max_str_digits()} digits"
+        return too_long_integer()
 
 
 def _describe(error: dict) -> str:

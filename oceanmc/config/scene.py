@@ -8,7 +8,7 @@ import numpy as np
 
 from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from .base import _Strict, non_finite_text, shown_value_error
+from .base import _Strict, non_finite_text, shown_value_error, too_long_integer
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
                      check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
@@ -97,8 +97,8 @@ class SceneConfig(_Strict):
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_PHOTONS:
             try:   # (pydantic's message had every digit of the value and of the limit)
                 shown = "-" * (value < 0) + readable_count(str(abs(value)))
-            except ValueError:   # str() of an integer of more than 4300 digits
-                shown = "an integer of more than 4300 digits"
+            except ValueError:   # str() of an integer too long for it
+                shown = too_long_integer()
             raise shown_value_error(shown, f"allowed: 1 .. {MAX_PHOTONS:.0e}")
         return value
 
