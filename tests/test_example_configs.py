@@ -13,6 +13,8 @@ import yaml
 import oceanmc
 from conftest import REPO
 from oceanmc.run.results import format_summary
+from oceanmc.run.simulation import prepare
+from oceanmc.scene import predicted_variant
 from oceanmc.sweeps import load_sweep
 from oceanmc.sweeps.dataset import variable_name
 from oceanmc.sweeps.points import build_points
@@ -38,7 +40,13 @@ def test_the_examples_are_there():
 
 @pytest.mark.parametrize("path", SCENES, ids=lambda p: p.stem)
 def test_every_shipped_scene_runs(path):
-    result = oceanmc.simulate(small(path), threads=2)
+    """Each scene runs, its budget closes, and `oceanmc run`'s prediction of its variant of the
+    photon loop from the config (compiled before the scene is packed) is the packed scene's
+    own: a wrong one would compile a second variant (kernel/variants.py)."""
+    config = small(path)
+    run = prepare(config)
+    assert predicted_variant(config) == run.scene.variant
+    result = oceanmc.simulate(run, threads=2)
     total = np.atleast_1d(result["budget/total"])
     assert np.all(np.abs(total - 1.0) < 0.05), total
     for name in ("air/Ed", "air/Eu", "Ed", "Eu"):

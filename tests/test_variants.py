@@ -7,12 +7,10 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import pytest
 import yaml
 
 from oceanmc.config import load_config
 from oceanmc.kernel.variants import EVERYTHING, PARTS, Variant, union
-from oceanmc.run.simulation import prepare
 from oceanmc.scene import predicted_variant
 
 REPO = Path(__file__).resolve().parents[1]
@@ -35,14 +33,6 @@ def test_supersets_are_the_variants_that_hold_it_nearest_first():
         plain._replace(spectral=True, local_estimates=True)
     assert plain.label == "plain" and spectral.kernel_args()[0] is True
     assert spectral.kernel_args()[1:] == (None,) * (len(PARTS) - 1)
-
-
-@pytest.mark.parametrize("name", sorted(p.stem for p in (REPO / "configs").glob("*.yaml")))
-def test_the_prediction_from_the_config_is_the_packed_scenes_own(name):
-    """`oceanmc run` compiles the variant it predicts from the configs before it packs them;
-    a wrong prediction would compile a second variant (the run checks the packed scene's)."""
-    config = load_config(REPO / "configs" / f"{name}.yaml")
-    assert predicted_variant(config) == prepare(config).scene.variant
 
 
 def test_a_scene_on_its_own_variant_gives_the_same_file_as_on_the_whole_loop(tmp_path,
