@@ -112,6 +112,22 @@ def test_photons_above_the_limit_are_refused_in_readable_digits(tmp_path, photon
     assert len(done.stderr.strip().splitlines()) == 1 and len(done.stderr) < 160
 
 
+@pytest.mark.parametrize("option, where", [
+    (("--seed", "9223372036854775808"), "--seed (with {file})"), ((), "{file}")])
+def test_a_seed_beyond_int64_is_refused_naming_the_allowed_range(tmp_path, small_scene,
+                                                                 option, where):
+    """--seed 9223372036854775808, and the same seed in the file, were refused in pydantic's
+    words ("Input should be less than 9223372036854775808")."""
+    small_scene["seed"] = 2**63 if not option else 5
+    scene_file = tmp_path / "scene.yaml"
+    scene_file.write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", scene_file, *option, "-o", tmp_path / "r.h5", cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr == (f"oceanmc: config error: {where.format(file=scene_file)}: seed = "
+                           "9223372036854775808: allowed: 0 .. 9223372036854775807\n")
+    assert not (tmp_path / "r.h5").exists()
+
+
 @pytest.mark.parametrize("option, value", [("--photons", "1.5e0"), ("--photons", "2.5e-1"),
                                            ("--threads", "2.5e0")])
 def test_a_count_in_e_notation_that_is_not_whole_is_refused(tmp_path, option, value):

@@ -270,6 +270,32 @@ def test_a_photon_count_beyond_the_limit_is_shown_in_readable_digits(tmp_path, s
     assert load_config(small_scene).photons == 10**13
 
 
+@pytest.mark.parametrize("written, shown", [
+    ("9223372036854775808", "9223372036854775808"), ("-1", "-1"),
+    ("1.0e+19", "1e+19"), ("9" * 30, "9999999999... (30 digits)")])
+def test_a_seed_beyond_int64_is_refused_naming_the_allowed_range(tmp_path, small_scene,
+                                                                 written, shown):
+    """`seed: 9223372036854775808` was refused in pydantic's words, "Input should be less than
+    9223372036854775808", a float beyond it as "Unable to parse input string as an integer,
+    exceeded maximum size"; -1 as "greater than or equal to 0". One range, as photons' are."""
+    small_scene["seed"] = "SENTINEL"
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", written))
+    with pytest.raises(ConfigError) as info:
+        load_config(path)
+    assert str(info.value) == f"{path}: seed = {shown}: allowed: 0 .. 9223372036854775807"
+    small_scene["seed"] = 2**63 - 1   # the limit itself loads
+    assert load_config(small_scene).seed == 2**63 - 1
+
+
+def test_a_seed_given_as_nan_names_the_exact_range(tmp_path, small_scene):
+    """The range of a bare nan's message was rounded to 6 digits: `an integer 0 ..
+    9.22337e+18`, which reads as if 9223372036854775807 were beyond it."""
+    small_scene["seed"] = "nan"
+    assert _error(small_scene) == ("config: seed = nan: not a finite number; allowed: an "
+                                   "integer 0 .. 9223372036854775807")
+
+
 def test_an_integer_of_more_than_4300_digits_is_refused_in_one_line(tmp_path, small_scene):
     """Python (3.11+) will not turn an integer of more than 4300 digits into text or back:
     one in a scene file was a ValueError traceback from PyYAML's int(), one in a dict (seed) a
@@ -283,8 +309,8 @@ def test_an_integer_of_more_than_4300_digits_is_refused_in_one_line(tmp_path, sm
     assert str(info.value).endswith(": an integer of 5000 digits; allowed: at most 4300 digits")
     small_scene["photons"] = 20000
     small_scene["seed"] = 10**5000
-    assert _error(small_scene) == ("config: seed = an integer of more than 4300 digits: Input "
-                                   "should be less than 9223372036854775808")
+    assert _error(small_scene) == ("config: seed = an integer of more than 4300 digits: "
+                                   "allowed: 0 .. 9223372036854775807")
 
 
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(

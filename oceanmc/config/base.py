@@ -98,7 +98,11 @@ def _numbers(annotation: Any, metadata: tuple = ()) -> list[tuple[type, tuple]]:
 
 
 def _bound(value: float) -> str:
-    return str(int(value)) if value == int(value) and abs(value) < 1e6 else f"{value:.6g}"
+    if value == int(value) and abs(value) < 1e6:
+        return str(int(value))
+    short = f"{value:.6g}"
+    # an integer bound that 6 digits would round (seed's 2**63 - 1, not 9.22337e+18) exactly
+    return str(value) if isinstance(value, int) and float(short) != value else short
 
 
 def _allowed_number(kind: type, constraints: tuple) -> str:

@@ -20,6 +20,7 @@ from .water import Water
 from .wavelengths import Wavelengths, check_increasing, grid
 
 MAX_PHOTONS = 10**13
+MAX_SEED = 2**63 - 1   # the seed is an int64 from here to the kernel
 
 
 def readable_count(text: str) -> str:
@@ -44,7 +45,7 @@ def _listed(wavelengths: list[float]) -> str:
 class SceneConfig(_Strict):
     name: str = "oceanmc scene"
     photons: Annotated[int, Field(gt=0, le=MAX_PHOTONS)] = 1_000_000
-    seed: Annotated[int, Field(ge=0, lt=2**63)] = 1
+    seed: Annotated[int, Field(ge=0, le=MAX_SEED)] = 1
     batches: Annotated[int, Field(ge=2, le=100_000)] = 32
     illumination: Illumination = Field(default_factory=Illumination)
     surface: Surface = Field(default_factory=Surface)
@@ -101,6 +102,26 @@ class SceneConfig(_Strict):
                 shown = too_long_integer()
             raise shown_value_error(shown, f"allowed: 1 .. {MAX_PHOTONS:.0e}")
         return value
+
+    @model_validator(mode="before")
+    @classmethod
+    def _seed_in_range(cls, data):
+        # pydantic said "less than 9223372036854775808", or of a float beyond int64 "Unable to
+        # parse input string as an integer, exceeded maximum size". Raised for the model, not
+        # as a field validator of seed, which would take seed out of _Strict's check of a
+        # quoted number (seed: '5')
+        seed = data.get("seed") if isinstance(data, dict) else None
+        number = (isinstance(seed, int) and not isinstance(seed, bool)) or \
+            (isinstance(seed, float) and math.isfinite(seed))   # (nan: _Strict's message)
+        if number and not 0 <= seed <= MAX_SEED:
+            try:   # exact, as the bound is; a long integer by its first digits
+                digits = repr(abs(seed))
+                shown = "-" * (seed < 0) + (digits if len(digits) <= 24
+                                            else readable_count(digits))
+            except ValueError:   # str() of an integer too long for it
+                shown = too_long_integer()
+            raise shown_value_error(shown, f"allowed: 0 .. {MAX_SEED}", "seed")
+        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> "SceneConfig":
