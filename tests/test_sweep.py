@@ -234,6 +234,50 @@ def test_a_bad_value_under_set_is_named_as_the_sweep_file_gives_it(tmp_path, set
     assert "\n" not in str(info.value) and "more point" not in str(info.value)
 
 
+@pytest.mark.parametrize("settings, axes, message", [
+    ({"bottom.model": "ggx", "bottom.roughness": 0.3}, {"water.layers[0].a": [0.1, 0.2]},
+     "set: bottom.model = 'ggx': takes no bottom.reflectance, which the base scene gives "
+     "(set: changes only the keys it names; give the whole bottom mapping there instead)"),
+    ({"bottom.model": "black"}, {"water.layers[0].a": [0.1, 0.2]},
+     "set: bottom.model = 'black': takes no bottom.reflectance, which the base scene gives "
+     "(set: changes only the keys it names; give the whole bottom mapping there instead)"),
+    ({"bottom.model": "minnaert"}, {"water.layers[0].a": [0.1, 0.2]},
+     "set: bottom.model = 'minnaert': bottom.k: required key is missing"),
+    # an axis that switches the model: its point, and the model's value
+    ({}, {"bottom.model": ["lambertian", "black"]},
+     "point (bottom.model = black): bottom.model = 'black': takes no bottom.reflectance, "
+     "which the base scene gives (an axis changes only the keys it names; give the whole "
+     "bottom mapping there instead)")])
+def test_a_model_switched_over_the_base_scenes_keys_names_the_switch_and_the_key(
+        tmp_path, settings, axes, message):
+    """`set: {bottom.model: ggx}` over a base scene's lambertian bottom (reflectance: 0.3)
+    was refused as `point (water.layers[0].a = 0.1): bottom.reflectance: unknown key; did you
+    mean diffuse_reflectance? (and 1 more point)`, blaming the axes; `minnaert` as `point
+    (...): bottom.k: required key is missing`. set: and the axes change only the keys they
+    name (README: Sweeps), so the message names the model's key path, its value and the
+    base scene's key it does not take (or the key it needs)."""
+    with pytest.raises(SweepError) as info:
+        build_points(load_sweep(sweep_file(tmp_path, axes, set=settings)))
+    assert str(info.value) == message
+    # what the message says to do: the whole mapping under set:
+    whole = {"bottom": {"model": "ggx", "roughness": 0.3}}
+    points = build_points(load_sweep(sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2]},
+                                                set=whole)))
+    assert [p.config.bottom.model for p in points] == ["ggx", "ggx"]
+
+
+def test_oceanmc_sweep_refuses_a_model_switched_by_set_in_one_line_exit_2(tmp_path):
+    path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2]},
+                      set={"bottom.model": "black"})
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", path, "-o", "lut.nc"],
+                          cwd=tmp_path, env=ENV, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == ("oceanmc: config error: set: bottom.model = 'black': takes no "
+                           "bottom.reflectance, which the base scene gives (set: changes only "
+                           "the keys it names; give the whole bottom mapping there instead)\n")
+    assert not (tmp_path / "lut.nc").exists() and not (tmp_path / "lut.points").exists()
+
+
 def test_a_table_file_under_set_that_cannot_be_read_is_named_as_set(tmp_path):
     """A table file given under `set:` that is missing or malformed (found when each point's
     scene is built, after the schema) was blamed on the first point, `point (water.layers[0].a

@@ -24,6 +24,11 @@ from .phase import Mixture, TablePhase
 from .scene import SceneConfig
 
 
+# the keys that say which member of a union a mapping is (a bottom's or a phase's model, a
+# profile's profile)
+DISCRIMINATORS = ("model", "profile")
+
+
 def _union_tags(root: type[BaseModel]) -> frozenset[str]:
     """The tags pydantic puts in an error's location to say which member of a union it tried:
     the `model` value of each member of a discriminated union (isotropic, ..., lambertian, ...)
@@ -40,7 +45,7 @@ def _union_tags(root: type[BaseModel]) -> frozenset[str]:
         elif origin in (Union, types.UnionType):
             for member in get_args(tp):
                 if isinstance(member, type) and issubclass(member, BaseModel):
-                    for key in ("model", "profile"):   # the discriminating keys
+                    for key in DISCRIMINATORS:
                         field = member.model_fields.get(key)
                         if field is not None and get_origin(field.annotation) is Literal:
                             tags.update(get_args(field.annotation))

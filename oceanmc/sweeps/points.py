@@ -6,11 +6,12 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 from dataclasses import dataclass
 
 from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
-from ..config.loading import data_file_fields
-from .axes import SweepError, SweepSpec
+from ..config.loading import DISCRIMINATORS, data_file_fields
+from .axes import SweepError, SweepSpec, parse_key_path
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,8 @@ def build_points(spec: SweepSpec) -> list[Point]:
             raise SweepError(str(exc)) from None   # a key path the base scene does not have
         except ConfigError as exc:
             text = _without_origin(exc)
+            text = _model_switch(text, spec, spec.settings, assignments, "set:") or \
+                _model_switch(text, spec, dict(assignments), assignments, "an axis") or text
             if _set_by(text, spec.settings) and not _set_by(text, dict(assignments)):
                 from_set.append(text)
                 text = f"set: {text}"
@@ -138,6 +141,48 @@ def _set_by(problem: str, values: dict) -> bool:
     under one of these key paths (the sweep file's `set:` keys, or a point's axis keys)."""
     return any(problem.startswith(str(key)) and problem[len(str(key)):][:1] in (":", " ", ".", "[")
                for key in values)
+
+
+# a point's problem with a key of a mapping (config/loading.py _describe): `PATH.KEY: unknown
+# key...` or `PATH.KEY: required key is missing`, and pydantic's count of its other problems
+_KEY_PROBLEM = re.compile(r"^(?P<mapping>.+)\.(?P<key>[A-Za-z_]\w*): "
+                          r"(?P<kind>unknown key|required key is missing)"
+                          r".*?(?P<more>(?: \(and \d+ more problems?\))?)$")
+
+
+def _model_switch(problem: str, spec: SweepSpec, values: dict, assignments,
+                  given_by: str) -> str | None:
+    """A point's problem with a key of a mapping whose model (or profile) `values` (the `set:`
+    keys, or a point's axis keys: `given_by`) change from the base scene's, the key not given
+    by the sweep file: said as the problem of that model's value, naming the base scene's key
+    the model does not take, or the key it needs. As it was (`bottom.reflectance: unknown key;
+    did you mean diffuse_reflectance?`) it blamed the point's coordinates: set: and the axes
+    change only the keys they name, and the rest of the base scene's mapping stays."""
+    found = _KEY_PROBLEM.match(problem)
+    if found is None or _set_by(problem, spec.settings) or _set_by(problem, dict(assignments)):
+        return None
+    mapping, key = found["mapping"], found["key"]
+    switch = next((f"{mapping}.{name}" for name in DISCRIMINATORS
+                   if f"{mapping}.{name}" in values), None)
+    if switch is None or _base_value(spec.base, switch) == values[switch]:
+        return None
+    if found["kind"] == "unknown key":
+        what = (f"takes no {mapping}.{key}, which the base scene gives ({given_by} changes "
+                f"only the keys it names; give the whole {mapping} mapping there instead)")
+    else:
+        what = f"{mapping}.{key}: required key is missing"
+    return f"{switch} = {values[switch]!r}: {what}{found['more']}"
+
+
+def _base_value(scene: dict, path: str):
+    """The base scene's value at a key path, or None where it has none."""
+    node = scene
+    for step in parse_key_path(path):
+        try:
+            node = node[step]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return node
 
 
 def _without_origin(exc: ConfigError) -> str:
