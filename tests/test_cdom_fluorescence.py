@@ -356,8 +356,8 @@ def test_summary_names_cdom_fluorescence(whole):
     ({"excitation_range_nm": [300, 550]}, ["excitation_range_nm", "[300, 550]", "[310, 550]"]),
     ({"excitation_range_nm": [310, 600]}, ["excitation_range_nm", "[310, 600]", "[310, 550]"]),
     ({"excitation_range_nm": [450, 400]}, ["excitation_range_nm", "[450, 400]", "increasing"]),
-    ({"a0_scale": -1}, ["cdom_fluorescence.a0_scale", "-1", "greater than or equal to 0"]),
-    ({"a0_scale": 60}, ["cdom_fluorescence.a0_scale", "60", "less than or equal to 50"]),
+    ({"a0_scale": -1}, ["cdom_fluorescence.a0_scale", "-1", "allowed: a number 0 .. 50"]),
+    ({"a0_scale": 60}, ["cdom_fluorescence.a0_scale", "60", "allowed: a number 0 .. 50"]),
     ({"quantum_yield": 0.01}, ["cdom_fluorescence.quantum_yield", "unknown key"]),
 ])
 def test_bad_values_are_refused_with_one_clear_line(settings, needles):

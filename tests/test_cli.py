@@ -124,7 +124,7 @@ def test_a_seed_beyond_int64_is_refused_naming_the_allowed_range(tmp_path, small
     done = oceanmc("run", scene_file, *option, "-o", tmp_path / "r.h5", cwd=tmp_path)
     assert done.returncode == 2
     assert done.stderr == (f"oceanmc: config error: {where.format(file=scene_file)}: seed = "
-                           "9223372036854775808: allowed: 0 .. 9223372036854775807\n")
+                           "9223372036854775808: allowed: an integer 0 .. 9223372036854775807\n")
     assert not (tmp_path / "r.h5").exists()
 
 

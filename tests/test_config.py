@@ -1,6 +1,9 @@
 """Config loading and validation: every bad scene gets one clear ConfigError naming the key path,
 the value and what is allowed."""
 import math
+import os
+import subprocess
+import sys
 
 import pytest
 import yaml
@@ -81,32 +84,32 @@ def _error(scene) -> str:
 
 @pytest.mark.parametrize("change, key, fragment", [
     (lambda s: s["water"]["layers"][0].update(a=-1), "water.layers[0].a = -1",
-     "greater than or equal to 0"),
+     "allowed: a number 0 .. 1e+06"),
     (lambda s: s["water"]["layers"][0].update(b=-0.5), "water.layers[0].b = -0.5",
-     "greater than or equal to 0"),
+     "allowed: a number 0 .. 1e+06"),
     (lambda s: s["water"]["layers"][0]["phase"].update(g=1.0),
-     "water.layers[0].phase.g = 1.0", "less than 1"),
+     "water.layers[0].phase.g = 1.0", "allowed: a number > -1 and < 1"),
     (lambda s: s["water"]["layers"][0]["phase"].update(g=-1.0),
-     "water.layers[0].phase.g = -1.0", "greater than -1"),
+     "water.layers[0].phase.g = -1.0", "allowed: a number > -1 and < 1"),
     (lambda s: s["surface"].update(n_water=0.9), "surface.n_water = 0.9",
-     "greater than or equal to 1"),
+     "allowed: a number 1 .. 3"),
     (lambda s: s["bottom"].update(reflectance=1.5), "bottom.reflectance = 1.5",
-     "less than or equal to 1"),
+     "allowed: a number 0 .. 1"),
     (lambda s: s["bottom"].update(reflectance=-0.1), "bottom.reflectance = -0.1",
-     "greater than or equal to 0"),
+     "allowed: a number 0 .. 1"),
     (lambda s: s["illumination"].update(sun_zenith_deg=90), "illumination.sun_zenith_deg = 90",
-     "less than 90"),
+     "allowed: a number >= 0 and < 90"),
     (lambda s: s["illumination"].update(sun_zenith_deg=-1), "illumination.sun_zenith_deg = -1",
-     "greater than or equal to 0"),
+     "allowed: a number >= 0 and < 90"),
     (lambda s: s["illumination"].update(diffuse_fraction=1.2),
-     "illumination.diffuse_fraction = 1.2", "less than or equal to 1"),
+     "illumination.diffuse_fraction = 1.2", "allowed: a number 0 .. 1"),
     (lambda s: s["illumination"].update(sky="stormy"), "illumination.sky = 'stormy'",
      "'cardioidal'"),
-    (lambda s: s.update(photons=0), "photons = 0", "greater than 0"),
+    (lambda s: s.update(photons=0), "photons = 0", "allowed: an integer 1 .. 1e+13"),
     (lambda s: s.update(photons="many"), "photons = 'many'", "integer"),
     (lambda s: s["tallies"].update(depths_m=[0, 5]), "tallies.depths_m", "below the bottom"),
     (lambda s: s["tallies"].update(depths_m=[-1]), "tallies.depths_m[0] = -1",
-     "greater than or equal to 0"),
+     "allowed: a number >= 0"),
     (lambda s: s["tallies"].update(theta_edges_deg=[0, 100, 90, 180]), "tallies.theta_edges_deg",
      "increase"),
     (lambda s: s["water"]["layers"][0].update(colour="blue"), "water.layers[0].colour",
@@ -116,7 +119,7 @@ def _error(scene) -> str:
     (lambda s: s["bottom"].update(model="minnaert"), "bottom.k", "missing"),
     (lambda s: s["water"]["layers"][0].update(a=math.nan), "water.layers[0].a = nan", "finite"),
     (lambda s: s["water"]["layers"][0].update(thickness_m=0), "water.layers[0].thickness_m = 0",
-     "greater than 0"),
+     "allowed: a number > 0"),
     (lambda s: s["water"]["layers"][0]["phase"].update(model="mie"),
      "water.layers[0].phase.model = 'mie'", "'petzold'"),
     (lambda s: s["water"]["layers"][0]["phase"].pop("model"), "water.layers[0].phase.model",
@@ -135,7 +138,7 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
     (lambda s: s.update(estimator={"upward_fraction": "autoo"}),
      "config: estimator.upward_fraction = 'autoo': allowed: a valid number or 'auto'"),
     (lambda s: s.update(estimator={"upward_fraction": -0.1}),
-     "config: estimator.upward_fraction = -0.1: allowed: a number greater than 0 or 'auto'"),
+     "config: estimator.upward_fraction = -0.1: allowed: a number > 0 and < 1 or 'auto'"),
     (lambda s: s["tallies"].update(theta_edges_deg="hydrolite"),
      "config: tallies.theta_edges_deg = 'hydrolite': allowed: 'hydrolight' or a valid list"),
     (lambda s: s["bottom"].update(reflectance={"fil": "sand.csv"}),
@@ -151,6 +154,42 @@ def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
     is named before the keys it leaves missing."""
     change(small_scene)
     assert _error(small_scene) == message
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s.update(batches=1), "batches = 1: allowed: an integer 2 .. 100000"),
+    (lambda s: s["water"]["layers"][0].update(thickness_m=-1),
+     "water.layers[0].thickness_m = -1: allowed: a number > 0"),
+    (lambda s: s["illumination"].update(sun_zenith_deg=95),
+     "illumination.sun_zenith_deg = 95: allowed: a number >= 0 and < 90"),
+    (lambda s: s["bottom"].update(reflectance=1.5),
+     "bottom.reflectance = 1.5: allowed: a number 0 .. 1"),
+    (lambda s: s["bottom"].update(reflectance=[0.2, -0.1]),
+     "bottom.reflectance[1] = -0.1: allowed: a number 0 .. 1"),
+    (lambda s: s["water"]["layers"][0]["phase"].update(g=1.0),
+     "water.layers[0].phase.g = 1.0: allowed: a number > -1 and < 1"),
+    (lambda s: s["surface"].update(model="cox_munk", wind_speed_m_s=40),
+     "surface.wind_speed_m_s = 40: allowed: a number 0 .. 30"),
+    (lambda s: s.update(wavelengths_nm=[400, 50]),
+     "wavelengths_nm[1] = 50: allowed: a number 100 .. 10000"),
+    (lambda s: s["tallies"].update(local_directions_deg=[[120, 360]]),
+     "tallies.local_directions_deg[0][1] = 360: allowed: a number >= 0 and < 360"),
+    (lambda s: s.update(photons=0), "photons = 0: allowed: an integer 1 .. 1e+13"),
+])
+def test_a_number_out_of_range_names_the_range_the_key_allows(tmp_path, small_scene, change,
+                                                               message):
+    """Out of its range, a number was refused in pydantic's words, one bound at a time
+    ('batches = 1: Input should be greater than or equal to 2'); now as photons' and seed's
+    were, with the key's whole range as a bare nan's message writes it, and by `oceanmc run`
+    in that one line, exit status 2."""
+    change(small_scene)
+    assert _error(small_scene) == f"config: {message}"
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(small_scene))
+    done = subprocess.run([sys.executable, "-m", "oceanmc", "run", str(path), "-o",
+                           str(tmp_path / "r.h5")], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600, env=dict(os.environ, PYTHONPATH=str(REPO)))
+    assert (done.returncode, done.stderr) == (2, f"oceanmc: config error: {path}: {message}\n")
+
 
 
 @pytest.mark.parametrize("change, message", [
@@ -254,18 +293,19 @@ def test_yaml_infinity_and_nan_are_refused_where_a_finite_number_is_needed(
 def test_a_photon_count_beyond_the_limit_is_shown_in_readable_digits(tmp_path, small_scene):
     """`photons: 100000000000000000000` (an integer to YAML) was refused as pydantic's `photons
     = 100000000000000000000: Input should be less than or equal to 10000000000000`: every digit
-    of the value and of the limit. Shown as the float forms are (`photons = 1e+308: allowed: 1
-    .. 1e+13`), and as `--photons` shows one (cli.py, config.scene.readable_count)."""
+    of the value and of the limit. Shown as the float forms are (`photons = 1e+308: allowed: an
+    integer 1 .. 1e+13`), and as `--photons` shows one (cli.py, config.scene.readable_count)."""
     small_scene["photons"] = "SENTINEL"
     path = tmp_path / "scene.yaml"
     path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", "100000000000000000000"))
     with pytest.raises(ConfigError) as info:
         load_config(path)
-    assert str(info.value) == f"{path}: photons = 1e+20: allowed: 1 .. 1e+13"
+    assert str(info.value) == f"{path}: photons = 1e+20: allowed: an integer 1 .. 1e+13"
     for value, shown in ((-10**20, "-1e+20"), (10**400, "1000000000... (401 digits)"),
                          (10**5000, "an integer of more than 4300 digits")):
         small_scene["photons"] = value
-        assert _error(small_scene) == f"config: photons = {shown}: allowed: 1 .. 1e+13"
+        assert _error(small_scene) == \
+            f"config: photons = {shown}: allowed: an integer 1 .. 1e+13"
     small_scene["photons"] = 10**13   # the limit itself loads
     assert load_config(small_scene).photons == 10**13
 
@@ -283,7 +323,8 @@ def test_a_seed_beyond_int64_is_refused_naming_the_allowed_range(tmp_path, small
     path.write_text(yaml.safe_dump(small_scene).replace("SENTINEL", written))
     with pytest.raises(ConfigError) as info:
         load_config(path)
-    assert str(info.value) == f"{path}: seed = {shown}: allowed: 0 .. 9223372036854775807"
+    assert str(info.value) == \
+        f"{path}: seed = {shown}: allowed: an integer 0 .. 9223372036854775807"
     small_scene["seed"] = 2**63 - 1   # the limit itself loads
     assert load_config(small_scene).seed == 2**63 - 1
 
@@ -310,7 +351,7 @@ def test_an_integer_of_more_than_4300_digits_is_refused_in_one_line(tmp_path, sm
     small_scene["photons"] = 20000
     small_scene["seed"] = 10**5000
     assert _error(small_scene) == ("config: seed = an integer of more than 4300 digits: "
-                                   "allowed: 0 .. 9223372036854775807")
+                                   "allowed: an integer 0 .. 9223372036854775807")
 
 
 def test_a_number_with_an_exponent_is_a_number_and_a_name_that_looks_like_one_round_trips(

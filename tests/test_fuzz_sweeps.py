@@ -270,7 +270,7 @@ def test_more_than_100000_points_are_refused_before_any_is_built(monkeypatch):
 
 @pytest.mark.parametrize("changes, message", [
     ({"axes": {"chl": {"key": "water.layers[0].a", "values": [0.1, -1]}}},
-     "point (chl = -1): water.layers[0].a = -1: Input should be greater than or equal to 0"),
+     "point (chl = -1): water.layers[0].a = -1: allowed: a number 0 .. 1e+06"),
     ({"axes": {"zip": {"chl": {"key": "water.layers[0].a", "values": [0.1, -2]},
                        "bottom.reflectance": [0.1, 0.2]}}},
      "point (chl = -2, bottom.reflectance = 0.2): water.layers[0].a = -2: "),

@@ -125,7 +125,7 @@ def test_table_component_and_its_errors(tmp_path):
      r"wavelengths_nm: stop = 400.0 is below start = 700.0"),
     ({"layer": {"components": [{"model": "cdom", "a440": {
         "profile": "linear", "depths_m": [0, 10], "values": [0.1, -0.1]}}]}},
-     r"components\[0\]\.a440\.values\[1\] = -0\.1: Input should be greater than or equal to 0"),
+     r"components\[0\]\.a440\.values\[1\] = -0\.1: allowed: a number >= 0$"),
     ({"layer": {"a": 0.1, "b": 0.1, "components": [{"model": "pure_water"}]}},
      r"a, b given with components"),
     ({"layer": {"a": [0.1, 0.2], "b": 0.1}, "wavelengths_nm": [400, 500, 600]},

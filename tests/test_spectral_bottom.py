@@ -85,9 +85,9 @@ def test_the_new_users_reflectance_list_is_accepted():
     ({"model": "minnaert", "k": 0.5, "reflectance": [0.1, 0.2, 0.3, 0.4]},
      ("bottom.reflectance has 4 values",)),
     ({"model": "lambertian", "reflectance": [0.1, 1.2, 0.3]},
-     ("bottom.reflectance[1] = 1.2", "less than or equal to 1")),
+     ("bottom.reflectance[1] = 1.2", "allowed: a number 0 .. 1")),
     ({"model": "lambertian", "reflectance": [0.1, -0.01, 0.3]},
-     ("bottom.reflectance[1] = -0.01", "greater than or equal to 0")),
+     ("bottom.reflectance[1] = -0.01", "allowed: a number 0 .. 1")),
     ({"model": "lambertian", "reflectance": [0.1, float("nan"), 0.3]},
      ("bottom.reflectance[1] = nan",)),
     ({"model": "mixture", "components": [
@@ -101,7 +101,7 @@ def test_the_new_users_reflectance_list_is_accepted():
     ({"model": "mixture", "components": [
         {"fraction": 0.0, "model": "lambertian", "reflectance": 0.1},
         {"fraction": 1.0, "model": "lambertian", "reflectance": 0.2}]},
-     ("bottom.components[0].fraction = 0", "greater than 0")),
+     ("bottom.components[0].fraction = 0", "allowed: a number > 0 and <= 1")),
     ({"model": "mixture", "components": [
         {"fraction": 0.5, "model": "minnaert", "k": 0.5, "reflectance": 0.1},
         {"fraction": 0.5, "model": "minnaert", "k": 0.6, "reflectance": 0.2}]},

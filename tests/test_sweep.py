@@ -217,13 +217,14 @@ def test_every_point_is_validated_first_with_its_coordinates_one_line_exit_2(tmp
     ({"water.layers[0].q": 1}, {"bottom.reflectance": [0.1, 0.2]},
      r"set: water\.layers\[0\]\.q: unknown key \(check its spelling and level\)"),
     ({"illumination.sun_zenith_deg": 300}, {"bottom.reflectance": [0.1, 0.2]},
-     r"set: illumination\.sun_zenith_deg = 300: Input should be less than 90"),
+     r"set: illumination\.sun_zenith_deg = 300: allowed: a number >= 0 and < 90"),
     # at one point only: which one, and that the value is the set's
     ({"photons": 10}, {"batches": [4, 8]},
      r"point \(batches = 8\): set: photons = 10: need at least 2 per batch \(batches = 8\)"),
     # the axis's value, not the set's: the point, as before
     ({"bottom": {"model": "lambertian", "reflectance": 0.3}}, {"bottom.reflectance": [0.1, 1.5]},
-     r"point \(bottom\.reflectance = 1\.5\): bottom\.reflectance = 1\.5: Input should be")])
+     r"point \(bottom\.reflectance = 1\.5\): bottom\.reflectance = 1\.5: allowed: a number 0 "
+     r"\.\. 1$")])
 def test_a_bad_value_under_set_is_named_as_the_sweep_file_gives_it(tmp_path, settings, axes,
                                                                    message):
     """A `set:` key the scene refuses was blamed on the first point, `(and N more points)`,

@@ -140,13 +140,24 @@ def non_finite_text(text: str, annotations: list[Any]) -> str | None:
     if not _NON_FINITE_WORD.match(text):
         return None   # (1e400, which float() makes inf, is a number beyond the range)
     number = float(text)
-    numbers = [n for a in annotations for n in _numbers(a)]
-    if math.isinf(number) and any(_admits_infinity(*n, number) for n in numbers):
+    if math.isinf(number) and any(_admits_infinity(*n, number)
+                                  for a in annotations for n in _numbers(a)):
         return (f"YAML reads a bare {text} as text; write {'-' if number < 0 else ''}.inf for "
                 "infinity")
-    allowed = " or ".join(dict.fromkeys(_allowed_number(*n) for n in numbers)) or \
-        "a finite number"
-    return f"not a finite number; allowed: {allowed}"
+    return f"not a finite number; allowed: {allowed_numbers(annotations) or 'a finite number'}"
+
+
+def allowed_numbers(annotations: list[Any], broken: dict[str, Any] | None = None) -> str:
+    """The numbers the annotations allow, in words (`an integer 2 .. 100000`, `a number >= 0
+    and < 90`, several joined by `or`); '' where they hold no number. broken: the bound a
+    value broke, as pydantic's error context gives it ({'ge': 2}), to name only the numbers
+    with that bound (those of a union's member the value was tried against)."""
+    numbers = [n for a in annotations for n in _numbers(a)]
+    if broken:
+        numbers = [(kind, constraints) for kind, constraints in numbers
+                   if any(getattr(c, name, None) == bound for c in constraints
+                          for name, bound in broken.items())] or numbers
+    return " or ".join(dict.fromkeys(_allowed_number(*n) for n in numbers))
 
 
 def too_long_integer() -> str:

@@ -17,7 +17,8 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
-from .base import QUOTED_NUMBER, SHOWN_VALUE, ConfigError, too_long_integer
+from .base import (QUOTED_NUMBER, SHOWN_VALUE, ConfigError, _items, _Strict, allowed_numbers,
+                   too_long_integer)
 from .bottom import ReflectanceSpectrum, TableBottom, reflectance_keys
 from .illumination import SkyMap
 from .phase import Mixture, TablePhase
@@ -263,36 +264,58 @@ def _key_path(loc: tuple) -> str:
 
 def _suggestion(loc: tuple) -> str:
     """ "; did you mean KEY?" with the nearest valid key at that level, if one is close."""
-    model: Any = SceneConfig
-    for part in loc[:-1]:
-        if isinstance(part, int) or part in _UNION_TAGS:
-            continue
-        field = getattr(model, "model_fields", {}).get(part)
-        if field is None:
-            return " (check its spelling and level)"
-        model = _model_of(field.annotation, loc)
-    names = list(getattr(model, "model_fields", {}))
+    above = _annotations_at(loc[:-1])
+    if above is None:
+        return " (check its spelling and level)"
+    names = [name for annotation in above for member, _ in _alternatives(annotation)
+             if isinstance(_bare(member), type) and issubclass(_bare(member), BaseModel)
+             for name in _bare(member).model_fields]
     close = difflib.get_close_matches(str(loc[-1]), names, n=1, cutoff=0.6)
     return f"; did you mean {close[0]}?" if close else " (check its spelling and level)"
 
 
-def _model_of(annotation: Any, loc: tuple) -> Any:
-    """The model class a field holds (through lists, Annotated and unions: the member whose
-    `model` tag is in the error's location, else the only model)."""
-    candidates: list[type[BaseModel]] = []
+def _alternatives(annotation: Any, tags: tuple = ()) -> list[tuple[Any, tuple]]:
+    """(member, the union tags that name it) of each member of a union, through Annotated
+    (kept around a member, with the bounds in it) and nested unions; a model member is named
+    by its `model` or `profile` value too. Not a union: the annotation alone."""
+    origin = get_origin(annotation)
+    inner, *metadata = get_args(annotation) if origin is Annotated else (annotation,)
+    here = tags + tuple(m.tag for m in metadata if isinstance(m, Tag))
+    if get_origin(inner) in (Union, types.UnionType):
+        return [alternative for member in get_args(inner)
+                for alternative in _alternatives(member, here)]
+    if isinstance(inner, type) and issubclass(inner, BaseModel):
+        here += tuple(tag for key in DISCRIMINATORS if key in inner.model_fields
+                      and get_origin(inner.model_fields[key].annotation) is Literal
+                      for tag in get_args(inner.model_fields[key].annotation))
+    return [(annotation, here)]
 
-    def visit(tp: Any) -> None:
-        if isinstance(tp, type) and issubclass(tp, BaseModel):
-            candidates.append(tp)
-        for arg in get_args(tp):
-            visit(arg)
-    visit(annotation)
-    for candidate in candidates:
-        field = candidate.model_fields.get("model")
-        if field is not None and get_origin(field.annotation) is Literal and \
-                set(get_args(field.annotation)) & set(loc):
-            return candidate
-    return candidates[0] if len(candidates) == 1 else None
+
+def _bare(annotation: Any) -> Any:
+    """The type inside Annotated."""
+    return get_args(annotation)[0] if get_origin(annotation) is Annotated else annotation
+
+
+def _annotations_at(loc: tuple) -> list[Any] | None:
+    """The annotations of the value at a location in SceneConfig (an error's: keys, list
+    indices and pydantic's names of union members), each with the bounds it carries; None
+    where a key is not in the schema."""
+    current: list[Any] = [SceneConfig]
+    for part in loc:
+        alternatives = [alt for annotation in current for alt in _alternatives(annotation)]
+        members = [_bare(a) for a, _ in alternatives]
+        if isinstance(part, int):
+            current = [item for member in members if get_origin(member) in (list, tuple)
+                       for item in _items(member, part)]
+        elif _is_branch_tag(part):   # the member named (others: constrained-float, list[...])
+            current = [a for a, tags in alternatives if part in tags] or current
+        else:
+            current = [member.model_fields[member._input_names()[part]].rebuild_annotation()
+                       for member in members if isinstance(member, type)
+                       and issubclass(member, _Strict) and part in member._input_names()]
+        if not current:
+            return None
+    return current
 
 
 def _shown(value: Any) -> str:
@@ -331,12 +354,29 @@ def _describe(error: dict) -> str:
         return f"{path}.{key}: required key is missing"
     if path == "(top level)" and kind == "value_error":
         return msg
+    allowed = _allowed_range(error)
+    if allowed:
+        msg = f"allowed: {allowed}"
     if "input" in error and not isinstance(error["input"], dict):
         shown = _shown(error["input"])
         if len(shown) > 80:
             shown = shown[:77] + "..."
         return f"{path} = {shown}: {msg}"
     return f"{path}: {msg}"
+
+
+# pydantic's types of the error for a number beyond one of its bounds
+_BOUND_ERRORS = frozenset({"greater_than", "greater_than_equal", "less_than", "less_than_equal"})
+
+
+def _allowed_range(error: dict) -> str:
+    """For a number beyond a bound, the range its key allows, in words (base.allowed_numbers:
+    pydantic's message names only the bound it broke, `Input should be greater than or equal
+    to 2`); '' for another error, or a location not found in the schema."""
+    if error.get("type") not in _BOUND_ERRORS:
+        return ""
+    annotations = _annotations_at(tuple(error.get("loc", ())))
+    return allowed_numbers(annotations, error.get("ctx")) if annotations else ""
 
 
 def _first_problem(errors: list[dict]) -> tuple[str, int]:
@@ -364,11 +404,8 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
         return _describe(first), 1
     allowed: list[str] = []
     for error in members:
-        text = error.get("msg", "").split(", unable")[0]
+        text = _allowed_range(error) or error.get("msg", "").split(", unable")[0]
         text = text[len("Input should be "):] if text.startswith("Input should be ") else text
-        if error.get("type") in ("greater_than", "greater_than_equal", "less_than",
-                                 "less_than_equal"):
-            text = "a number " + text
         if text not in allowed:
             allowed.append(text)
     shown = _shown(first["input"]) if "input" in first else "this value"

@@ -8,7 +8,8 @@ import numpy as np
 
 from pydantic import Field, PrivateAttr, field_validator, model_validator
 
-from .base import _Strict, non_finite_text, shown_value_error, too_long_integer
+from .base import (_Strict, allowed_numbers, non_finite_text, shown_value_error,
+                   too_long_integer)
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
                      check_bottom_wavelengths)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
@@ -93,14 +94,14 @@ class SceneConfig(_Strict):
             value = number if math.isfinite(number) else value
         if isinstance(value, float) and math.isfinite(value) and value == int(value):
             if abs(value) > MAX_PHOTONS:   # else shown as the 309 digits of int(1e308)
-                raise ValueError(f"allowed: 1 .. {MAX_PHOTONS:.0e}")
+                raise ValueError(cls._allowed("photons"))
             return int(value)
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_PHOTONS:
             try:   # (pydantic's message had every digit of the value and of the limit)
                 shown = "-" * (value < 0) + readable_count(str(abs(value)))
             except ValueError:   # str() of an integer too long for it
                 shown = too_long_integer()
-            raise shown_value_error(shown, f"allowed: 1 .. {MAX_PHOTONS:.0e}")
+            raise shown_value_error(shown, cls._allowed("photons"))
         return value
 
     @model_validator(mode="before")
@@ -120,8 +121,13 @@ class SceneConfig(_Strict):
                                             else readable_count(digits))
             except ValueError:   # str() of an integer too long for it
                 shown = too_long_integer()
-            raise shown_value_error(shown, f"allowed: 0 .. {MAX_SEED}", "seed")
+            raise shown_value_error(shown, cls._allowed("seed"), "seed")
         return data
+
+    @classmethod
+    def _allowed(cls, key: str) -> str:
+        """What a key's bounds allow, as the message of any number out of its range says."""
+        return f"allowed: {allowed_numbers([cls.model_fields[key].rebuild_annotation()])}"
 
     @model_validator(mode="after")
     def _consistent(self) -> "SceneConfig":
