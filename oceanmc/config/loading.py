@@ -264,14 +264,20 @@ def _key_path(loc: tuple) -> str:
 
 def _suggestion(loc: tuple) -> str:
     """ "; did you mean KEY?" with the nearest valid key at that level, if one is close."""
-    above = _annotations_at(loc[:-1])
-    if above is None:
-        return " (check its spelling and level)"
-    names = [name for annotation in above for member, _ in _alternatives(annotation)
-             if isinstance(_bare(member), type) and issubclass(_bare(member), BaseModel)
-             for name in _bare(member).model_fields]
-    close = difflib.get_close_matches(str(loc[-1]), names, n=1, cutoff=0.6)
+    names = schema_keys(loc[:-1]) or set()
+    close = difflib.get_close_matches(str(loc[-1]), sorted(names), n=1, cutoff=0.6)
     return f"; did you mean {close[0]}?" if close else " (check its spelling and level)"
+
+
+def schema_keys(loc: tuple) -> set[str] | None:
+    """The keys the schema allows in the mapping at a location (keys and list indices: an
+    error's, or a sweep's key path): the fields of every model that may stand there (each
+    member of a union); None where the schema does not say (a path it does not know, or one
+    to a value that is not a mapping)."""
+    models = [_bare(member) for annotation in _annotations_at(loc) or []
+              for member, _ in _alternatives(annotation)
+              if isinstance(_bare(member), type) and issubclass(_bare(member), BaseModel)]
+    return {name for model in models for name in model.model_fields} if models else None
 
 
 def _alternatives(annotation: Any, tags: tuple = ()) -> list[tuple[Any, tuple]]:

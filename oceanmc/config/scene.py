@@ -39,6 +39,18 @@ def readable_count(text: str) -> str:
     return f"{number:.3g}" if math.isfinite(number) else repr(text[:21] + "...")
 
 
+def _shown_beyond(value: int | float, exact: bool = False) -> str:
+    """A number beyond its key's range as a message shows it: by readable_count (exact, up to
+    24 digits, where the bound is written exactly: seed's), or, for an integer too long for
+    str(), in words."""
+    try:
+        digits = str(abs(value))
+    except ValueError:
+        return too_long_integer()
+    return "-" * (value < 0) + (digits if exact and len(digits) <= 24
+                                else readable_count(digits))
+
+
 def _listed(wavelengths: list[float]) -> str:
     return ", ".join(f"{w:g}" for w in wavelengths)
 
@@ -97,11 +109,8 @@ class SceneConfig(_Strict):
                 raise ValueError(cls._allowed("photons"))
             return int(value)
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_PHOTONS:
-            try:   # (pydantic's message had every digit of the value and of the limit)
-                shown = "-" * (value < 0) + readable_count(str(abs(value)))
-            except ValueError:   # str() of an integer too long for it
-                shown = too_long_integer()
-            raise shown_value_error(shown, cls._allowed("photons"))
+            # (pydantic's message had every digit of the value and of the limit)
+            raise shown_value_error(_shown_beyond(value), cls._allowed("photons"))
         return value
 
     @model_validator(mode="before")
@@ -115,13 +124,9 @@ class SceneConfig(_Strict):
         number = (isinstance(seed, int) and not isinstance(seed, bool)) or \
             (isinstance(seed, float) and math.isfinite(seed))   # (nan: _Strict's message)
         if number and not 0 <= seed <= MAX_SEED:
-            try:   # exact, as the bound is; a long integer by its first digits
-                digits = repr(abs(seed))
-                shown = "-" * (seed < 0) + (digits if len(digits) <= 24
-                                            else readable_count(digits))
-            except ValueError:   # str() of an integer too long for it
-                shown = too_long_integer()
-            raise shown_value_error(shown, cls._allowed("seed"), "seed")
+            # exact, as the bound is
+            raise shown_value_error(_shown_beyond(seed, exact=True), cls._allowed("seed"),
+                                    "seed")
         return data
 
     @classmethod

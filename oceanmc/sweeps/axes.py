@@ -20,13 +20,14 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, get_args
+from typing import Any
 
 import numpy as np
 import yaml
 
 from ..config import ConfigError
 from ..config.base import exponent_number
+from ..config.loading import schema_keys
 
 # a key, then any number of [index]: `layers[0]`, `components[-1]`, `bottom`
 _SEGMENT = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[-?\d+\])*)$")
@@ -97,7 +98,7 @@ def _check_missing_key(written: str, steps: list[str | int], depth: int, node: d
     there; an unknown key (with the nearest valid one: the schema's keys at that level and the
     base scene's) or one followed by a list index (there is no list to index) is refused."""
     step, following = steps[depth], steps[depth + 1]
-    allowed = _schema_keys(steps[:depth])
+    allowed = schema_keys(tuple(steps[:depth]))
     if allowed is not None and step not in allowed:
         close = difflib.get_close_matches(step, sorted(allowed | set(map(str, node))), n=1,
                                           cutoff=0.6)
@@ -108,35 +109,6 @@ def _check_missing_key(written: str, steps: list[str | int], depth: int, node: d
         raise SweepError(f"{written}: the base scene has no {_render(steps[:depth + 1])}, so "
                          f"[{following}] does not apply; give {_render(steps[:depth + 1])} in the "
                          "base scene, or make the whole list an axis's value")
-
-
-def _schema_keys(steps: list[str | int]) -> set[str] | None:
-    """The keys the scene's schema allows in the mapping that `steps` lead to (the fields of
-    every model that may stand there: each member of a union), or None where the schema does
-    not say (a path it does not know, a free mapping). Used for messages only: the paths
-    themselves are not tied to the schema."""
-    from ..config import SceneConfig
-    models: list[type] = [SceneConfig]
-    for step in steps:
-        if isinstance(step, int):
-            continue   # a list's items: the annotation's models already stand for them
-        found: list[type] = []
-        for model in models:
-            field = model.model_fields.get(step)
-            if field is not None:
-                found += _models_in(field.annotation)
-        if not found:
-            return None
-        models = found
-    return {name for model in models for name in model.model_fields}
-
-
-def _models_in(annotation: Any) -> list[type]:
-    """The pydantic models an annotation holds (through lists, unions, Annotated, Optional)."""
-    from pydantic import BaseModel
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return [annotation]
-    return [model for arg in get_args(annotation) for model in _models_in(arg)]
 
 
 def _render(steps: list[str | int]) -> str:
