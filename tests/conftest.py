@@ -26,6 +26,20 @@ def small_scene():
     return copy.deepcopy(SMALL_SCENE)
 
 
+@pytest.fixture
+def thread_client():
+    """A Dask client of one in-process worker with two threads (so that a test's monkeypatch
+    reaches the points it runs), its scheduler's HTTP routes on a free port of 127.0.0.1 as
+    sweeps.execute.local_client's are: left on 8787, two such tests at once in parallel
+    processes warned 'Port 8787 is already in use'."""
+    from distributed import Client, LocalCluster
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                      dashboard_address=None,
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
+            Client(cluster) as client:
+        yield client
+
+
 @pytest.fixture(scope="session", autouse=True)
 def whole_photon_loop():
     """The photon loop with every optional part compiled in (kernel/variants.py), made ready

@@ -124,17 +124,15 @@ def test_every_shipped_sweep_loads_with_all_its_points_valid(path):
     assert len(points) == int(np.prod(spec.shape)) > 1
 
 
-def test_the_sweep_example_runs_with_named_dimensions_and_no_empty_direction(tmp_path):
-    from distributed import Client, LocalCluster
+def test_the_sweep_example_runs_with_named_dimensions_and_no_empty_direction(tmp_path,
+                                                                            thread_client):
     path = REPO / "configs" / "sweeps" / "shallow_lut.yaml"
     spec = tiny(path)
     said = []
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        ds = oceanmc.sweep(spec, tmp_path / "lut.nc", client=client, threads=1)
-        # a rerun finds both points done: a SPECTRL2 scene's stored text (with its note on
-        # the diffuse share) is the text the sweep expects of the point
-        oceanmc.sweep(spec, tmp_path / "lut.nc", client=client, threads=1, log=said.append)
+    ds = oceanmc.sweep(spec, tmp_path / "lut.nc", client=thread_client, threads=1)
+    # a rerun finds both points done: a SPECTRL2 scene's stored text (with its note on
+    # the diffuse share) is the text the sweep expects of the point
+    oceanmc.sweep(spec, tmp_path / "lut.nc", client=thread_client, threads=1, log=said.append)
     assert ds.attrs["points_done"] == 2 and ds.attrs["points_failed"] == 0
     assert "2 finished earlier, 0 to run" in " ".join(said), said
     # the short names are the dimensions; a440 is a coordinate along chl (a zip group)
@@ -158,13 +156,10 @@ def test_the_sweep_example_runs_with_named_dimensions_and_no_empty_direction(tmp
             == float(ds["air_Rrs_nadir"].sel(chl=0.3, bottom_depth=2, wavelength=555).item())
 
 
-def test_a_sweep_with_local_directions_keeps_its_direction_dimension(tmp_path):
-    from distributed import Client, LocalCluster
+def test_a_sweep_with_local_directions_keeps_its_direction_dimension(tmp_path, thread_client):
     spec = tiny(REPO / "configs" / "sweeps" / "shallow_lut.yaml")
     spec["set"]["tallies.local_directions_deg"] = [[180, 0]]
     spec["axes"] = {"chl": spec["axes"]["zip"][0]["chl"]}
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        ds = oceanmc.sweep(copy.deepcopy(spec), None, client=client, threads=1)
+    ds = oceanmc.sweep(copy.deepcopy(spec), None, client=thread_client, threads=1)
     assert ds["air_Rrs_local"].dims == ("chl", "wavelength", "direction")
     assert ds["direction_theta"].values.tolist() == [180.0]

@@ -387,9 +387,7 @@ def test_local_cluster_two_processes_points_bit_identical_batch_groups_and_rerun
                                 .drop_vars(["wall_time_s"]), ds.drop_vars(["wall_time_s"]))
 
 
-def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch):
-    from distributed import Client, LocalCluster
-
+def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch, thread_client):
     import oceanmc.run.simulation as simulation
     real = simulation.simulate
 
@@ -400,9 +398,7 @@ def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch):
 
     monkeypatch.setattr(simulation, "simulate", simulate)  # the workers are threads here
     path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2, 0.3]})
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        ds = oceanmc.sweep(path, tmp_path / "lut.nc", client=client, threads=1)
+    ds = oceanmc.sweep(path, tmp_path / "lut.nc", client=thread_client, threads=1)
     assert list(ds["status"].values) == ["done", "failed", "done"]
     assert ds["error"].values[1] == "FloatingPointError: the kernel gave up on this point"
     assert np.isnan(ds["air_Rrs_nadir"].values[1])
@@ -497,64 +493,61 @@ def test_ctrl_c_leaves_a_valid_partial_dataset_and_a_rerun_finishes_it(tmp_path)
 
 # --- a dataset of another sweep is never replaced without --overwrite ---------------------------
 
-def test_another_sweeps_dataset_is_refused_without_overwrite_and_a_rerun_is_not(tmp_path):
+def test_another_sweeps_dataset_is_refused_without_overwrite_and_a_rerun_is_not(
+        tmp_path, thread_client):
     """lut.nc of sweep A: sweep B (other axis values, or another base scene) to the same lut.nc
     is refused in one line, exit 2, before anything runs, the dataset and the points folder
     untouched; A again, or A with a value added to an axis, replaces it (the resume feature);
     --overwrite replaces another sweep's dataset."""
-    from distributed import Client, LocalCluster
-
     out = tmp_path / "lut.nc"
     a = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1],
                               "bottom.reflectance": [0.1, 0.2]})
     a = a.rename(tmp_path / "a.yaml")
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
-        first = oceanmc.sweep(a, out, client=client, threads=1)
-        assert first.attrs["points_done"] == 4
-        before = out.read_bytes()
-        folder = sorted(p.name for p in (tmp_path / "lut.points").iterdir())
+    first = oceanmc.sweep(a, out, client=thread_client, threads=1)
+    assert first.attrs["points_done"] == 4
+    before = out.read_bytes()
+    folder = sorted(p.name for p in (tmp_path / "lut.points").iterdir())
 
-        def refused(spec, *words):
-            done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", spec, "-o",
-                                   "lut.nc", "-q"], cwd=tmp_path, env=ENV, capture_output=True,
-                                  text=True, timeout=300)
-            assert done.returncode == 2, done.stderr
-            assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr, done.stderr
-            assert done.stderr.startswith("oceanmc: error: lut.nc holds the dataset of another "
-                                          "sweep ("), done.stderr
-            assert "--overwrite" in done.stderr
-            for word in words:
-                assert word in done.stderr, done.stderr
-            assert out.read_bytes() == before
-            assert sorted(p.name for p in (tmp_path / "lut.points").iterdir()) == folder
-            return done.stderr
-
-        # other values on the same axes (a.yaml's 0.05 gone), then another base scene
-        b = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.3],
-                                  "bottom.reflectance": [0.1, 0.2]}).rename(tmp_path / "b.yaml")
-        refused(b, "its point (water.layers[0].a = 0.05, bottom.reflectance = 0.1) is not one "
-                   "of this sweep's, and 1 more of its 4 points")
-        other_base = copy.deepcopy(TINY)
-        other_base["seed"] = 8
-        c = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1],
-                                  "bottom.reflectance": [0.1, 0.2]}, base=other_base)
-        refused(c.rename(tmp_path / "c.yaml"), "its base scene differs: seed differs")
-        with pytest.raises(oceanmc.sweeps.OutputExists, match="another sweep"):
-            oceanmc.sweep(b, out, client=client, threads=1)     # the Python call refuses too
+    def refused(spec, *words):
+        done = subprocess.run([sys.executable, "-m", "oceanmc", "sweep", spec, "-o",
+                               "lut.nc", "-q"], cwd=tmp_path, env=ENV, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 2, done.stderr
+        assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr, done.stderr
+        assert done.stderr.startswith("oceanmc: error: lut.nc holds the dataset of another "
+                                      "sweep ("), done.stderr
+        assert "--overwrite" in done.stderr
+        for word in words:
+            assert word in done.stderr, done.stderr
         assert out.read_bytes() == before
+        assert sorted(p.name for p in (tmp_path / "lut.points").iterdir()) == folder
+        return done.stderr
 
-        # the same sweep with its axes in another order and a value added: not another sweep
-        spec = yaml.safe_load(a.read_text())
-        spec["axes"] = {"bottom.reflectance": [0.1, 0.2],
-                        "water.layers[0].a": [0.05, 0.1, 0.2]}
-        a.write_text(yaml.safe_dump(spec, sort_keys=False))
-        said = []
-        grown = oceanmc.sweep(a, out, client=client, threads=1, log=said.append)
-        assert "4 finished earlier, 2 to run" in said[0] and grown.attrs["points_done"] == 6
+    # other values on the same axes (a.yaml's 0.05 gone), then another base scene
+    b = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.3],
+                              "bottom.reflectance": [0.1, 0.2]}).rename(tmp_path / "b.yaml")
+    refused(b, "its point (water.layers[0].a = 0.05, bottom.reflectance = 0.1) is not one "
+               "of this sweep's, and 1 more of its 4 points")
+    other_base = copy.deepcopy(TINY)
+    other_base["seed"] = 8
+    c = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.1],
+                              "bottom.reflectance": [0.1, 0.2]}, base=other_base)
+    refused(c.rename(tmp_path / "c.yaml"), "its base scene differs: seed differs")
+    with pytest.raises(oceanmc.sweeps.OutputExists, match="another sweep"):
+        oceanmc.sweep(b, out, client=thread_client, threads=1)     # the Python call refuses too
+    assert out.read_bytes() == before
 
-        replaced = oceanmc.sweep(b, out, client=client, threads=1, overwrite=True)
-        assert list(replaced["water.layers[0].a"].values) == [0.1, 0.3]
+    # the same sweep with its axes in another order and a value added: not another sweep
+    spec = yaml.safe_load(a.read_text())
+    spec["axes"] = {"bottom.reflectance": [0.1, 0.2],
+                    "water.layers[0].a": [0.05, 0.1, 0.2]}
+    a.write_text(yaml.safe_dump(spec, sort_keys=False))
+    said = []
+    grown = oceanmc.sweep(a, out, client=thread_client, threads=1, log=said.append)
+    assert "4 finished earlier, 2 to run" in said[0] and grown.attrs["points_done"] == 6
+
+    replaced = oceanmc.sweep(b, out, client=thread_client, threads=1, overwrite=True)
+    assert list(replaced["water.layers[0].a"].values) == [0.1, 0.3]
     stored = xr.open_dataset(out, engine="h5netcdf").load()
     assert list(stored["water.layers[0].a"].values) == [0.1, 0.3]
     # a file that is no sweep dataset: refused as well

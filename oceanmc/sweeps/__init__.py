@@ -117,9 +117,10 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
     source: a sweep YAML file or a mapping {base: scene file | scene mapping | SceneConfig,
     axes: {key path: [values], name: {key: key path, values: [values]}, zip: {key path:
     [values], ...}}, set: {key path: value}, batch_groups: N} (an axis given a name is the
-    dataset's dimension of that name, e.g. `chl`, instead of its key path's). The points run on `client` (a distributed.Client), on the scheduler at
-    `scheduler` (tcp://HOST:PORT), or on a local cluster of `workers` processes (default: one
-    per core), `threads` threads each (default: the cores shared among the local workers).
+    dataset's dimension of that name, e.g. `chl`, instead of its key path's). The points run
+    on `client` (a distributed.Client), on the scheduler at `scheduler` (tcp://HOST:PORT), or
+    on a local cluster of `workers` processes (default: one per core), `threads` threads each
+    (default: the cores shared among the local workers).
     Finished points are kept in `<output stem>.points/` (a temporary folder without output):
     a rerun skips them. workers_write: the workers write the points' files there themselves
     (they must see that folder: a shared file system; default: only on the local cluster
