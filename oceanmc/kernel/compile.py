@@ -36,6 +36,11 @@ folders that hold oceanmc's marker file: OCEANMC_CACHE_DIR may name a folder tha
 user's own numba-* folders. Numba reads its CACHE_DIR when a function is decorated, so
 the decorators here set it for the kernel's functions alone and restore it afterwards.
 
+`internal` functions get no machine code of their own (_LinkOnlyLibrary): only other compiled
+functions call them, and Numba links their LLVM IR into each caller's module, which it then
+optimises and compiles as one, so their own module-level optimisation and machine code were
+never run (run/compiling.py has the measurements).
+
 With NUMBA_DISABLE_JIT=1 all of these are plain Python functions."""
 import getpass
 import hashlib
@@ -44,7 +49,13 @@ import shutil
 import tempfile
 from pathlib import Path
 
+import llvmlite.binding as llvm
 import numba
+from numba.core import codegen as numba_codegen
+from numba.core.compiler import CompilerBase, DefaultPassBuilder
+from numba.core.compiler_lock import require_global_compiler_lock
+from numba.core.compiler_machinery import LoweringPass, register_pass
+from numba.core.typed_passes import AnnotateTypes
 
 
 def _kernel_hash() -> str:
@@ -95,6 +106,70 @@ if CACHE_WRITABLE:
             shutil.rmtree(_stale, ignore_errors=True)  # caches of earlier kernel sources
 
 
+class _LinkOnlyLibrary(numba_codegen.JITCodeLibrary):
+    """The code library of an `internal` function: Numba's own but for finalize, which links
+    the callees' IR as Numba does and keeps the result as the module other functions link in
+    (the function-level passes of add_llvm_module have run on it), but skips the module-level
+    optimisation and the machine code of the function itself (a third of a cold compilation
+    of the whole loop: 18 s of LLVM optimisation and 17 s of machine code, one process, for
+    code that nothing calls; run/compiling.py). What it hands to the JIT engine is a module
+    of the function's global variables alone (Numba's environment pointer, which
+    CPUContext.get_executable sets for every compiled function, with or without an entry
+    point). The disk cache stores it as Numba stores any library (serialize_using_object_code:
+    that small module's object code and the linking IR), and loads it as Numba's own."""
+
+    def finalize(self):
+        require_global_compiler_lock()
+        self._raise_if_finalized()
+        seen = set()
+        for library in self._linking_libraries:   # as CPUCodeLibrary.finalize links them
+            if library not in seen:
+                self._reload_init.update(library._reload_init)
+                seen.add(library)
+                self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        self._final_module.verify()
+        self._verify_declare_only_symbols()
+        self._finalize_dynamic_globals()   # (a library with dynamic globals is not cached)
+        linking = self._final_module.clone()
+        for function in linking.functions:   # as _get_module_for_linking makes them
+            if not function.is_declaration and function.linkage == llvm.Linkage.external:
+                function.linkage = "linkonce_odr"
+        self._shared_module = linking
+        header = str(self._codegen._create_empty_module(self.name))   # (triple, data layout)
+        self._final_module = llvm.parse_assembly(header + "\n".join(
+            str(variable) for variable in self._final_module.global_variables
+            if not variable.is_declaration))
+        self._final_module.name = linking.name
+        self._finalize_final_module()
+
+
+@register_pass(mutates_CFG=False, analysis_only=False)
+class _LinkOnlyLowering(LoweringPass):
+    """Gives the function a _LinkOnlyLibrary before Numba's native lowering, which otherwise
+    makes a library of its own kind."""
+    _name = "oceanmc_link_only_library"
+
+    def __init__(self):
+        LoweringPass.__init__(self)
+
+    def run_pass(self, state):
+        if state.library is None:
+            state.library = _LinkOnlyLibrary(state.targetctx.codegen(),
+                                             state.func_id.func_qualname)
+            state.library.enable_object_caching()
+        return True
+
+
+class _LinkOnlyCompiler(CompilerBase):
+    """Numba's nopython pipeline with _LinkOnlyLowering just before its lowering."""
+
+    def define_pipelines(self):
+        pipeline = DefaultPassBuilder.define_nopython_pipeline(self.state)
+        pipeline.add_pass_after(_LinkOnlyLowering, AnnotateTypes)
+        pipeline.finalize()
+        return [pipeline]
+
+
 def _jit(**options):
     def decorate(function):
         previous = numba.config.CACHE_DIR
@@ -107,7 +182,8 @@ def _jit(**options):
 
 
 kernel = _jit(_nrt=False, no_cfunc_wrapper=True)
-internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True)
+internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True,
+                pipeline_class=_LinkOnlyCompiler)
 hot = _jit(_nrt=False, no_cfunc_wrapper=True, forceinline=True)
 batch = _jit(_nrt=False, nogil=True)
 setup = _jit()
