@@ -182,8 +182,12 @@ def _jit(**options):
 
 
 kernel = _jit(_nrt=False, no_cfunc_wrapper=True)
+# _LinkOnlyLibrary.finalize stands in for a private method of Numba's code library as Numba
+# 0.68 writes it; with another Numba, `internal` functions are compiled as Numba compiles any
+# (the same machine code in the end, a longer compilation)
+LINK_ONLY = numba.__version__.startswith("0.68.")
 internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True,
-                pipeline_class=_LinkOnlyCompiler)
+                **({"pipeline_class": _LinkOnlyCompiler} if LINK_ONLY else {}))
 hot = _jit(_nrt=False, no_cfunc_wrapper=True, forceinline=True)
 batch = _jit(_nrt=False, nogil=True)
 setup = _jit()

@@ -74,24 +74,23 @@ Where the time goes (LLVM's pass timings, every part compiled in one process, 41
 c484c1c, 2026-11-27): trace_batch's own module, after both halves, takes 1.0 s of the cheap
 (inlining) passes, 9.05 s of full optimisation (LICM 1.1 s, InstCombine 0.9 s, about half of
 it in the analyses between passes) and 5.7 s of machine code: 14.7 s that no second process
-can share. The 181 callees' own LLVM work is 15 s of optimisation and 6.9 s of machine code,
-which is never run (only their IR is linked into trace_batch), but Numba finalises every
-function it compiles. Machine code at the target machine's level 1 instead of 3 (NUMBA_OPT=1
+can share. The 181 callees' own LLVM work was 15 s of optimisation and 6.9 s of machine code,
+which is never run (only their IR is linked into trace_batch), since Numba finalises every
+function it compiles (no longer: below). Machine code at the target machine's level 1 instead of 3 (NUMBA_OPT=1
 before Numba's code generator starts) took as long (5.6 s). So with one merged trace_batch a
 cold start cannot fall below 14.7 s plus the longer half and Python's start-up: the 15 s of
 issue 26 needs trace_batch split (the calls by address above cost run time) or smaller (a
 trace_batch per feature set, compiled when a scene first needs it).
-The callees' own optimisation and machine code can be skipped: a prototype (2026-11-28, not
-shipped; a patch of Numba 0.68's CPUCodeLibrary.finalize for libraries with neither a Python
-nor a C entry point: link their callees' IR, no final optimisation, no machine code, cached as
-bitcode; CPUContext.get_executable then gives them an entry point of address 0, as Numba does
-for a function without a Python wrapper, without setting its environment) compiled the whole
-loop in one process in 96 s against 132 s (events 30 against 42 s, the collision 22 against
-43 s, trace_batch 45 against 47 s; empty caches, one run each with tests beside them) and the
-plain variant in 22 against 26-31 s, with the bare-walk scene's 27 tallies bit for bit the
-same and its photons/s unchanged (3.10 against 2.89 million, one run each). What is left is
-trace_batch's own compilation, so a cold start would fall by about a fifth, not to 15 s; it
-needs the two processes' cache of bitcode proved and the kernel's full proof.
+The callees' own optimisation and machine code are skipped (kernel/compile.py
+_LinkOnlyLibrary, for `internal` functions, by a pipeline of Numba's own with a library of
+their own kind): their IR, after Numba's function-level passes, is what trace_batch links and
+optimises. Every output of every shipped config and validation scene is the same bit for bit
+(benchmarks/regression.md) and the loop runs as fast (benchmarks/speed.md). Measured first as a
+patch of Numba (one process, empty cache, tests beside it): the whole loop 96 s against 132 s
+(events 30 against 42 s, the collision 22 against 43 s, trace_batch 45 against 47 s). As
+shipped, ready() with an empty cache, one run each, A then B (2026-11-28): the plain variant
+15.6 s against 20.7 s, the whole loop 78.9 s against 92.8 s (trace_batch's own compilation,
+which no second process shares, is most of what is left).
 """
 from __future__ import annotations
 
