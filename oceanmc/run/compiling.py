@@ -88,9 +88,12 @@ optimises. Every output of every shipped config and validation scene is the same
 (benchmarks/regression.md) and the loop runs as fast (benchmarks/speed.md). Measured first as a
 patch of Numba (one process, empty cache, tests beside it): the whole loop 96 s against 132 s
 (events 30 against 42 s, the collision 22 against 43 s, trace_batch 45 against 47 s). As
-shipped, ready() with an empty cache, one run each, A then B (2026-11-28): the plain variant
-15.6 s against 20.7 s, the whole loop 78.9 s against 92.8 s (trace_batch's own compilation,
-which no second process shares, is most of what is left).
+shipped (2026-11-28, kernel 54ffa5b against 74e89e7, quiet machine): ready() with an empty
+cache, one run each, the plain variant 15.6 s against 20.7 s, the whole loop 78.9 s against
+92.8 s; a cold `oceanmc run CONFIG --photons 20000` on its own variant, interleaved:
+bare_walk.yaml 19.4 / 15.2 s against 26.4 / 23.7 s, default.yaml 39.5 / 37.7 s against
+49.7 / 49.9 s, windy_case1.yaml 44.4 s against 61.5 s, raman_fluorescence.yaml 62.7 s against
+85.9 s. What is left is mostly trace_batch's own compilation, which no second process shares.
 """
 from __future__ import annotations
 
