@@ -39,7 +39,7 @@ def _defined(module):
     return [f.name for f in module.functions if not f.is_declaration]
 
 
-def test_internal_functions_have_linking_ir_and_no_machine_code(tmp_path, monkeypatch):
+def test_internal_functions_have_linking_ir_and_no_machine_code(monkeypatch):
     from oceanmc.kernel import compile as kernel_compile
     monkeypatch.setattr(kernel_compile, "CACHE_WRITABLE", False)   # nothing of it cached
 
@@ -55,7 +55,11 @@ def test_internal_functions_have_linking_ir_and_no_machine_code(tmp_path, monkey
     (halved,) = halve.overloads.values()
     (called,) = caller.overloads.values()
     assert isinstance(halved.library, kernel_compile._LinkOnlyLibrary)
-    assert _defined(halved.library._final_module) == []   # what the JIT engine compiles
+    engine_gets = halved.library._final_module   # what the JIT engine compiles
+    assert _defined(engine_gets) == []
+    # (the environment pointer, which Numba sets for every compiled function)
+    assert any("NumbaEnv" in v.name for v in engine_gets.global_variables
+               if not v.is_declaration)
     assert any("halve" in name for name in _defined(halved.library._get_module_for_linking()))
     assert not isinstance(called.library, kernel_compile._LinkOnlyLibrary)
     assert any("caller" in name for name in _defined(called.library._final_module))
@@ -81,3 +85,25 @@ def test_a_cached_internal_function_links_into_a_new_caller_in_another_process(t
         env=env, capture_output=True, text=True, timeout=300)
     assert second.returncode == 0, second.stderr
     assert second.stdout.split() == ["27.0", "1", "1"]
+
+
+def test_recursive_internal_functions_are_compiled_as_numba_compiles_any(monkeypatch):
+    """Mutual recursion leaves a call that Numba resolves from the callee's machine code at run
+    time (RuntimeLinker): such a library gets its machine code (without it the call aborted:
+    'unresolved symbol')."""
+    from oceanmc.kernel import compile as kernel_compile
+    monkeypatch.setattr(kernel_compile, "CACHE_WRITABLE", False)
+
+    @kernel_compile.internal
+    def count_down(n):
+        return 0 if n <= 0 else 1 + count_down_other(n - 1)
+
+    @kernel_compile.internal
+    def count_down_other(n):
+        return 0 if n <= 0 else 1 + count_down(n - 1)
+
+    @kernel_compile.kernel
+    def caller(n):
+        return count_down(n)
+
+    assert caller(5) == 5

@@ -36,10 +36,10 @@ folders that hold oceanmc's marker file: OCEANMC_CACHE_DIR may name a folder tha
 user's own numba-* folders. Numba reads its CACHE_DIR when a function is decorated, so
 the decorators here set it for the kernel's functions alone and restore it afterwards.
 
-`internal` functions get no machine code of their own (_LinkOnlyLibrary): only other compiled
-functions call them, and Numba links their LLVM IR into each caller's module, which it then
-optimises and compiles as one, so their own module-level optimisation and machine code were
-never run (run/compiling.py has the measurements).
+With Numba 0.68 (LINK_ONLY), `internal` functions get no machine code of their own
+(_LinkOnlyLibrary): only other compiled functions call them, and Numba links their LLVM IR into
+each caller's module, which it then optimises and compiles as one, so their own module-level
+optimisation and machine code would never be used (run/compiling.py has the measurements).
 
 With NUMBA_DISABLE_JIT=1 all of these are plain Python functions."""
 import getpass
@@ -52,6 +52,7 @@ from pathlib import Path
 import llvmlite.binding as llvm
 import numba
 from numba.core import codegen as numba_codegen
+from numba.core.codegen import RuntimeLinker
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_lock import require_global_compiler_lock
 from numba.core.compiler_machinery import LoweringPass, register_pass
@@ -110,16 +111,20 @@ class _LinkOnlyLibrary(numba_codegen.JITCodeLibrary):
     """The code library of an `internal` function: Numba's own but for finalize, which links
     the callees' IR as Numba does and keeps the result as the module other functions link in
     (the function-level passes of add_llvm_module have run on it), but skips the module-level
-    optimisation and the machine code of the function itself (a third of a cold compilation
-    of the whole loop: 18 s of LLVM optimisation and 17 s of machine code, one process, for
-    code that nothing calls; run/compiling.py). What it hands to the JIT engine is a module
-    of the function's global variables alone (Numba's environment pointer, which
+    optimisation and the machine code of the functions (a third of a cold compilation of the
+    whole loop: 18 s of LLVM optimisation and 17 s of machine code, one process, for code that
+    nothing calls; run/compiling.py). What it hands to the JIT engine is a module of the
+    linked module's defined global variables alone (Numba's environment pointers, which
     CPUContext.get_executable sets for every compiled function, with or without an entry
-    point). The disk cache stores it as Numba stores any library (serialize_using_object_code:
-    that small module's object code and the linking IR), and loads it as Numba's own."""
+    point; constant exception arguments). The disk cache stores it as Numba stores any library
+    (serialize_using_object_code: that small module's object code and the linking IR), and
+    loads it as Numba's own. A function that reaches a call Numba could not resolve when it
+    compiled it (recursion: RuntimeLinker, filled from the machine code of the function it
+    names) is compiled as Numba compiles any."""
 
     def finalize(self):
         require_global_compiler_lock()
+        self._codegen._check_llvm_bugs()
         self._raise_if_finalized()
         seen = set()
         for library in self._linking_libraries:   # as CPUCodeLibrary.finalize links them
@@ -127,9 +132,13 @@ class _LinkOnlyLibrary(numba_codegen.JITCodeLibrary):
                 self._reload_init.update(library._reload_init)
                 seen.add(library)
                 self._final_module.link_in(library._get_module_for_linking(), preserve=True)
+        if any(variable.name.startswith(RuntimeLinker.PREFIX)
+               for variable in self._final_module.global_variables):
+            self._optimize_final_module()   # the rest of CPUCodeLibrary.finalize
+            self._final_module.verify()
+            self._finalize_final_module()
+            return
         self._final_module.verify()
-        self._verify_declare_only_symbols()
-        self._finalize_dynamic_globals()   # (a library with dynamic globals is not cached)
         linking = self._final_module.clone()
         for function in linking.functions:   # as _get_module_for_linking makes them
             if not function.is_declaration and function.linkage == llvm.Linkage.external:
@@ -149,7 +158,7 @@ class _LinkOnlyLowering(LoweringPass):
     makes a library of its own kind."""
     _name = "oceanmc_link_only_library"
 
-    def __init__(self):
+    def __init__(self):   # (abstract in Numba's CompilerPass)
         LoweringPass.__init__(self)
 
     def run_pass(self, state):
@@ -182,9 +191,9 @@ def _jit(**options):
 
 
 kernel = _jit(_nrt=False, no_cfunc_wrapper=True)
-# _LinkOnlyLibrary.finalize stands in for a private method of Numba's code library as Numba
-# 0.68 writes it; with another Numba, `internal` functions are compiled as Numba compiles any
-# (the same machine code in the end, a longer compilation)
+# _LinkOnlyLibrary.finalize rewrites Numba 0.68's CPUCodeLibrary.finalize on its private
+# helpers; with another Numba, `internal` functions are compiled as Numba compiles any (the
+# same machine code in the end, a longer compilation)
 LINK_ONLY = numba.__version__.startswith("0.68.")
 internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forceinline=True,
                 **({"pipeline_class": _LinkOnlyCompiler} if LINK_ONLY else {}))
