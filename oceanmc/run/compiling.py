@@ -22,9 +22,9 @@ compiles the collision (the phase functions, the inelastic channels, the local e
 collision); trace_batch, compiled last, then loads the child's part from the cache. If the
 child fails or is slow, trace_batch compiles that part itself: the result is the same.
 trace_batch's own compilation is the longest single step and cannot be shared out: Numba links
-every callee's optimised LLVM IR into the entry point's module, then optimises it again (7.7 s,
-LLVM's pass timings) and generates machine code for all of it (4.8 s), after each callee did
-the same for its own. Measured one after the other in one process (2 cores, a CI run beside
+every callee's LLVM IR into the entry point's module, then optimises it (7.7 s, LLVM's pass
+timings) and generates machine code for all of it (4.8 s); until kernel 54ffa5b each callee had
+done the same for its own (the last paragraph). Measured one after the other in one process (2 cores, a CI run beside
 it): the collision 13.1 s, the surface events 4.6 s, the bottom 5.0 s, trace_batch 11.7 s. The
 collision alone here and the surface events beside the bottom in the child (before: collision
 and surface here, 16.3 s, against 8.8 s there) took a cold `oceanmc run configs/default.yaml`
