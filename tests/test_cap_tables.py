@@ -50,3 +50,25 @@ def test_the_grids_matrices_give_the_direct_moments(cap):
     assert np.array_equal(np.array(geometry.moments(isotropic)),
                           np.array(geometry.direct(isotropic)))
     assert len(geometry._operators) == 1
+
+
+@pytest.mark.parametrize("cap", ["water", "air (flat)", "air (7 m/s)"])
+def test_a_scenes_cap_shares_the_arrays_but_counts_its_own_phase_functions(cap):
+    """The geometry's arrays are built once per process and shared, read-only, by the scenes
+    that follow; each scene's geometry counts its own phase functions from 0 (when the sparse
+    matrices take over: LinearInCdf), so the moments of a scene do not depend on the scenes
+    packed before it in the process: a geometry that has taken over gives, in a new one, the
+    direct evaluation bit for bit."""
+    first = caps()[cap]
+    tables = [ff_table(float(r)) for r in np.linspace(0.005, 0.03, cap_tables.OPERATOR_AFTER)]
+    for table in tables:
+        first.moments(table)
+    assert first._operators   # the matrices took over
+    second = caps()[cap]
+    assert second is not first and not second._operators and not second._asked
+    assert second.psi is first.psi and not second.psi.flags.writeable
+    m0, m1 = second.moments(tables[-1])
+    direct = first.direct(tables[-1])
+    assert np.array_equal(m0, direct[0]) and np.array_equal(m1, direct[1])
+    with pytest.raises(ValueError):
+        second.psi[0, 0] = 1.0
