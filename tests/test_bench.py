@@ -10,6 +10,7 @@ import pytest
 from conftest import REPO
 
 
+@pytest.mark.long(cpu_s=133)
 def test_quick_bench_writes_report(tmp_path):
     bare_walk = REPO.parent / "shared" / "bench" / "bare_walk.py"
     args = [sys.executable, "-m", "oceanmc", "bench", "--quick", "-o", str(tmp_path / "b"),

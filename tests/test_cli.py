@@ -259,6 +259,7 @@ def test_start_up_time_is_the_first_runs_and_counts_loading_the_loop(tmp_path, s
         assert later.attrs["startup_time_s"] == 0.0
 
 
+@pytest.mark.long(cpu_s=15)
 def test_the_compiling_child_packs_the_scenes_it_is_given(tmp_path):
     """On a cold start the compiling child (run/compiling.py child_main) says on stdout when its
     part is compiled, then packs the scenes it was given, whose tables land in the disk caches

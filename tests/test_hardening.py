@@ -250,6 +250,7 @@ def test_small_upward_cone_density_does_not_cancel(small_scene):
     assert abs(density / (0.1 / solid_angle) - 1.0) < 1e-12
 
 
+@pytest.mark.long(cpu_s=19)
 def test_results_with_more_than_4100_layers_can_be_saved(tmp_path):
     # one budget/absorbed_layer_N per layer, each attached to the batch dimension scale: the
     # scale's reference list outgrew HDF5's 64 KB compact attribute limit at ~4,100 layers

@@ -305,6 +305,7 @@ def test_a_long_scene_name_fits_in_the_title(mono_file, spectral_file, tmp_path,
     close(fig)
 
 
+@pytest.mark.long(cpu_s=15)
 def test_output_folder_with_or_without_a_trailing_separator(mono_file, tmp_path, capsys):
     """-o DIR writes DIR/RESULT_*.png when DIR exists (with or without a trailing separator)
     or when DIR ends in one (created); otherwise -o is a prefix."""

@@ -120,6 +120,7 @@ def test_surface_dispatch_reaches_each_model():
 
 
 
+@pytest.mark.long(cpu_s=17)
 def test_channel_registry_and_dispatch():
     """Every registered collision channel has its module, its id is packed for the scenes that
     use it, and the dispatch runs it: the elastic channel turns a packet and keeps its weight

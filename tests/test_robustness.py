@@ -51,6 +51,7 @@ def long_scene(tmp_path):
     return path
 
 
+@pytest.mark.long(cpu_s=31)
 def test_sigint_writes_a_partial_file_and_resume_completes_it_bit_for_bit(tmp_path):
     # a third of LONG's photons in as many batches: the SIGINT still comes after the first
     # batch of 64 (the file appears), and the resumed and the whole run, which this test

@@ -358,6 +358,7 @@ def test_a_sweep_without_axes_is_one_point_and_exits_0(tmp_path):
 
 # --- a LocalCluster of two worker processes ---------------------------------------------------
 
+@pytest.mark.long(cpu_s=23)
 def test_local_cluster_two_processes_points_bit_identical_batch_groups_and_rerun(tmp_path):
     path = sweep_file(tmp_path, {"water.layers[0].a": [0.05, 0.2],
                                  "zip": {"bottom.reflectance": [0.1, 0.4],
@@ -433,6 +434,7 @@ def dask_processes(tmp_path):
         process.wait()
 
 
+@pytest.mark.long(cpu_s=16)
 def test_separate_scheduler_and_workers_survive_a_killed_worker(tmp_path, dask_processes):
     address, workers = dask_processes
     scene = copy.deepcopy(TINY)
@@ -458,6 +460,7 @@ def test_separate_scheduler_and_workers_survive_a_killed_worker(tmp_path, dask_p
 
 # --- Ctrl-C, then a rerun -------------------------------------------------------------------
 
+@pytest.mark.long(cpu_s=22)
 def test_ctrl_c_leaves_a_valid_partial_dataset_and_a_rerun_finishes_it(tmp_path):
     scene = copy.deepcopy(TINY)
     scene["photons"] = 20000
