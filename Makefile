@@ -9,8 +9,8 @@ STAMP  := $(VENV)/.installed-$(shell cksum pyproject.toml | cut -d' ' -f1)
 .PHONY: run test validate bench clean
 
 # pip byte-compiles what it installs on one core; the dependencies (numpy, scipy, numba, dask,
-# matplotlib, ...) are byte-compiled here on every core instead: a fresh install took 83 s
-# instead of 98 s on this project's 2-core machine (2026-11-28)
+# matplotlib, ...) are byte-compiled here on every core instead: a fresh venv's install took
+# 72 and 83 s against 79 and 97 s on this project's 2-core machine (interleaved, 2026-11-28)
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-compile -e ".[test]"
