@@ -173,13 +173,26 @@ def cap_geometry(beta: float, mu_bar: float, alphas: np.ndarray) -> CapGeometry:
     arrays kept for the process's next scenes (_cap_arrays); each call gives a CapGeometry of
     its own, whose count of phase functions (LinearInCdf: when the sparse matrices take over)
     starts at 0, so a scene's tables do not depend on the scenes packed before it."""
-    return CapGeometry(**_cap_arrays(beta, np.ascontiguousarray(alphas, np.float64).tobytes()),
-                       mu_bar=mu_bar)
+    return CapGeometry(**_cap_arrays(beta, _key(alphas)), mu_bar=mu_bar)
+
+
+def _key(alphas: np.ndarray) -> bytes:
+    """An alpha grid as the kept geometries' key (np.frombuffer gives it back)."""
+    return np.ascontiguousarray(alphas, np.float64).tobytes()
+
+
+def _read_only(fields: dict) -> dict:
+    """The fields of a kept geometry, its arrays made read-only: later scenes share them."""
+    for value in fields.values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    return fields
 
 
 # the arrays of the last CAP_ARRAYS_KEPT caps (56 MB each on the default alpha grid; a scene
-# uses two, the water cap and the flat air cap's water side): 0.4-0.5 s each to build, which a
-# scene whose moments are not cached (new IOPs: every point of a sweep) paid twice
+# uses two, the water cap and the flat air cap's water side): 0.4-0.5 s each to build, which
+# every scene whose cap moments are not remembered (a phase function new to the process: a
+# sweep over g or a particle backscattering ratio; Case-1 chlorophyll alone is not) paid twice
 CAP_ARRAYS_KEPT = 4
 
 
@@ -202,11 +215,8 @@ def _cap_arrays(beta: float, alpha_bytes: bytes) -> dict[str, np.ndarray]:
     # mean of cos(angle to the axis) over the arc |phi| < phi0, times the arc's share
     arc_mu = (phi0 * np.cos(alpha) * np.cos(mid)
               + np.sin(alpha) * np.sin(mid) * np.sin(phi0)) / math.pi
-    arrays = {"inside": inside, "cos_alpha": np.cos(alphas), "psi": psi, "phi0": phi0,
-              "arc_mu": arc_mu}
-    for array in arrays.values():
-        array.setflags(write=False)
-    return arrays
+    return _read_only({"inside": inside, "cos_alpha": np.cos(alphas), "psi": psi, "phi0": phi0,
+                       "arc_mu": arc_mu})
 
 
 def air_factor(mu_w: np.ndarray, n: float, transmittance) -> np.ndarray:
@@ -282,8 +292,7 @@ def rough_cap_geometry(alphas: np.ndarray, alpha: float, n: float, beta: float) 
     """The RoughCap of the air cap of half-angle beta through facets of roughness alpha, at
     the alpha grid alphas (the angles between a packet's direction and straight up); its
     arrays kept for the process's next scenes as cap_geometry's are."""
-    return RoughCap(**_rough_arrays(np.ascontiguousarray(alphas, np.float64).tobytes(), alpha,
-                                    n, beta))
+    return RoughCap(**_rough_arrays(_key(alphas), alpha, n, beta))
 
 
 # the arrays of the last ROUGH_ARRAYS_KEPT rough caps (25 MB each on the default alpha grid,
@@ -307,7 +316,5 @@ def _rough_arrays(alpha_bytes: bytes, alpha: float, n: float, beta: float) -> di
     psi = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, ROUGH_PSI_NODES)[None, :]
     rings = (np.arange(ROUGH_RING_NODES) + 0.5) * (math.pi / ROUGH_RING_NODES)
     a, b = rough_cap.ring_averages(alphas, psi, mu, density, mu_bar, rings)
-    arrays = {"mu_nodes": mu, "density": density, "psi": psi, "a": a, "b": b}
-    for array in arrays.values():
-        array.setflags(write=False)
-    return {**arrays, "mu_bar": mu_bar, "mass": float(mass)}
+    return _read_only({"mu_nodes": mu, "density": density, "psi": psi, "a": a, "b": b,
+                       "mu_bar": mu_bar, "mass": float(mass)})
