@@ -116,15 +116,17 @@ def test_spectral_section_splits_the_worst_band_into_time_and_variance():
         {"name": "scene A", "wavelengths": [400.0, 410.0, 420.0], "time_one_history_s": 2.0,
          "time_31_runs_s": 4.0, "events_one_history": 10.0, "events_31_runs": 80.0,
          "air/Rrs_nadir": bands,
-         "budget/water_leaving": {"fom_ratio": [11.0, 15.0, 10.0]}}]}
+         "budget/water_leaving": {"fom_ratio": [11.0, 15.0, 10.0],
+                                  "fom_ratio_uniform_heroes": [3.0, 1.25, 9.0]}}]}
     text = "\n".join(spectral.report_lines(data))
     # time ratio (4 / 500) / (2 / 1000) = 4; worst band 410 nm, 1.5 = 4 x 0.375
     # events ratio 80 / 10 = 8: ceiling 8 x 0.375 = 3
     assert "| scene A | 2.0 | 4.0 | Rrs nadir | 1.5 (410 nm) | 4.0 x 0.38 | 12.0 | 20.0 | **no** " \
-        "| 10.0 / 80 | 8.0 x 0.38 = 3.0 |" in text
+        "| - | 10.0 / 80 | 8.0 x 0.38 = 3.0 |" in text   # no uniform-hero run in this report
     assert "crossing" not in text.split("|---")[-1]   # a quantity the run did not measure
+    # with uniform heroes the worst band is another (410 nm)
     assert "| water-leaving fraction | 10.0 (420 nm) | 4.0 x 2.50 | 11.0 | 15.0 | yes | " \
-        "10.0 / 80 | 8.0 x 2.50 = 20.0 |" in text
+        "1.2 (410 nm) | 10.0 / 80 | 8.0 x 2.50 = 20.0 |" in text
 
 
 def test_spectral_section_pools_rounds():

@@ -24,7 +24,9 @@ Tried for the water-leaving fraction's weakest bands (blue, clear water), not ke
 - a larger upward bias (estimator.upward_fraction 0.2 and 0.3): identical to 0.1 bit for bit,
   the fraction being capped by 1 - w0 of the layer's most scattering wavelength (kernel/
   upward.py).
-(Hero probabilities weighted toward the long walks: kernel/spectral.py.)"""
+Kept: hero wavelengths drawn in proportion to 1 / (1 - w0) (kernel/spectral.py): the report's
+uniform-heroes column is the same one-history run with every wavelength equally likely, run
+beside it in every round."""
 from __future__ import annotations
 
 import json
@@ -56,9 +58,11 @@ BATCHES = 128
 ROUNDS = 3
 
 
-def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int) -> dict:
+def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int,
+          hero_exponent: float | None = None) -> dict:
+    """The scene's config; hero_exponent: estimator.hero_exponent if not the default."""
     thickness = BOTTOM_DEPTH_M if bottom else float("inf")
-    return {
+    config = {
         "name": f"Chl {chl:g} mg/m3, " + (f"Lambertian bottom at {BOTTOM_DEPTH_M:g} m"
                                           if bottom else "deep"),
         "photons": photons, "batches": BATCHES, "seed": seed, "wavelengths_nm": wavelengths,
@@ -70,6 +74,9 @@ def scene(chl: float, bottom: bool, photons: int, wavelengths, seed: int) -> dic
         # each run with its defaults (config/scene.py: nadir_local, upward_fraction auto)
         "tallies": {"depths_m": [0.0]},
     }
+    if hero_exponent is not None:
+        config["estimator"] = {"hero_exponent": hero_exponent}
+    return config
 
 
 def _timed(config: dict, threads: int):
@@ -115,12 +122,17 @@ def measure(quick: bool, say, threads: int = 2) -> dict:
         for bottom in (False, True):
             name = scene(chl, bottom, spectral_photons, WAVELENGTHS, 1)["name"]
             times_one, times_singles, events_one, events_singles = [], [], [], []
+            times_uniform, rel_uniform = [], {}
             values, rel_one, rel_single = {}, {}, {}
             for r in range(rounds):
                 say(f"spectral: {name}, round {r + 1} of {rounds} ...")
                 spectral, t_spectral = _timed(
                     scene(chl, bottom, spectral_photons, WAVELENGTHS, 1 + r), threads)
                 wavelengths = [float(w) for w in spectral.coords["wavelength"]]
+                # the same run with uniform hero probabilities (the default's bench row)
+                uniform, t_uniform = _timed(scene(chl, bottom, spectral_photons, WAVELENGTHS,
+                                                  1 + r, hero_exponent=0.0), threads)
+                times_uniform.append(t_uniform)
                 singles = [_timed(scene(chl, bottom, single_photons, [w], 1000 * (r + 1) + k),
                                   threads) for k, w in enumerate(wavelengths)]
                 times_one.append(t_spectral)
@@ -135,9 +147,13 @@ def measure(quick: bool, say, threads: int = 2) -> dict:
                     rel_one.setdefault(q, []).append(
                         [_relative(spectral, q, k) for k in range(len(wavelengths))])
                     rel_single.setdefault(q, []).append([_relative(s, q) for s, _ in singles])
+                    rel_uniform.setdefault(q, []).append(
+                        [_relative(uniform, q, k) for k in range(len(wavelengths))])
             t_spectral, t_singles = float(np.median(times_one)), float(np.median(times_singles))
+            t_uniform = float(np.median(times_uniform))
             row = {"name": name, "wavelengths": wavelengths,
                    "time_one_history_s": t_spectral, "time_31_runs_s": t_singles,
+                   "time_uniform_heroes_s": t_uniform,
                    "times_one_history_s": times_one, "times_31_runs_s": times_singles,
                    "events_one_history": float(np.mean(events_one)),
                    "events_31_runs": float(np.mean(events_singles))}
@@ -146,11 +162,14 @@ def measure(quick: bool, say, threads: int = 2) -> dict:
                 # a band no photon reached has rel_err inf, FOM 0
                 fom_one = [1.0 / (e * e * t_spectral) for e in one]
                 fom_single = [1.0 / (e * e * t_singles) for e in single]
+                fom_uniform = [1.0 / (e * e * t_uniform) for e in pooled(rel_uniform[q])]
                 row[q] = {"value": np.mean(values[q], axis=0).tolist(),
                           "rel_err_one_history": one, "rel_err_single": single,
                           "fom_one_history": fom_one, "fom_single": fom_single,
                           "fom_ratio": [a / b if b > 0.0 else float("inf")
-                                        for a, b in zip(fom_one, fom_single)]}
+                                        for a, b in zip(fom_one, fom_single)],
+                          "fom_ratio_uniform_heroes": [a / b if b > 0.0 else float("inf")
+                                                       for a, b in zip(fom_uniform, fom_single)]}
             out["scenes"].append(row)
     return out
 
@@ -184,10 +203,15 @@ def report_lines(data: dict) -> list[str]:
              "is its events) times the variance ratio, which is the estimator's and not the "
              "code's. Where the ceiling is below the target, no speed-up of the one-history "
              "walk reaches it.", "",
+             "Uniform heroes: the worst band's FOM ratio of the same one-history run with every "
+             "wavelength equally likely to be a photon's hero (estimator.hero_exponent: 0), run "
+             "beside it in every round; the default draws heroes in proportion to "
+             "1 / (1 - w0) (kernel/spectral.py).", "",
              "| scene | time one history (s) | time 31 runs (s) | quantity | FOM ratio: worst "
-             "band | = time ratio x variance ratio | median | best | target met | events per "
-             "photon: one history / 31 runs | ceiling: events ratio x variance ratio |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "band | = time ratio x variance ratio | median | best | target met | uniform heroes: "
+             "worst band | events per photon: one history / 31 runs | ceiling: events ratio x "
+             "variance ratio |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in data["scenes"]:
         per_photon = (row["time_31_runs_s"] / data["single_photons"]) / (
             row["time_one_history_s"] / data["spectral_photons"])
@@ -198,12 +222,18 @@ def report_lines(data: dict) -> list[str]:
             worst = int(np.argmin(ratio))
             variance = ratio[worst] / per_photon
             events = row["events_31_runs"] / row["events_one_history"]
+            if "fom_ratio_uniform_heroes" in row[name]:
+                uniform = np.array(row[name]["fom_ratio_uniform_heroes"])
+                k = int(np.argmin(uniform))
+                uniform_worst = f"{uniform[k]:.1f} ({row['wavelengths'][k]:g} nm)"
+            else:   # a report from before the comparison
+                uniform_worst = "-"
             lines.append(
                 f"| {row['name']} | {row['time_one_history_s']:.1f} | "
                 f"{row['time_31_runs_s']:.1f} | {label} | {ratio[worst]:.1f} "
                 f"({row['wavelengths'][worst]:g} nm) | {per_photon:.1f} x {variance:.2f} | "
                 f"{np.median(ratio):.1f} | {ratio.max():.1f} | "
-                f"{'yes' if ratio[worst] >= TARGET else '**no**'} | "
+                f"{'yes' if ratio[worst] >= TARGET else '**no**'} | {uniform_worst} | "
                 f"{row['events_one_history']:.1f} / {row['events_31_runs']:.0f} | "
                 f"{events:.1f} x {variance:.2f} = {events * variance:.1f} |")
     lines += ["", "Per band (value, relative errors one history / single run, FOM ratio) in "

@@ -56,6 +56,11 @@ class Estimator(_Strict):
     # measured best for the inelastic parts of Rrs (benchmarks/inelastic.md)
     emitted_light: Literal["carried", "packets"] = "carried"
     depth_splitting: Literal["auto", "on", "off"] = "auto"
+    # a spectral photon's hero wavelength is drawn with probability in proportion to
+    # (1 / (1 - w0))^hero_exponent, w0 the top layer's single-scattering albedo there
+    # (scene/medium.py hero_probabilities; 0: uniform). The default measured best for the
+    # spectral bench's weakest bands (benchmarks/spectral.md)
+    hero_exponent: Annotated[float, Field(ge=0.0, le=2.0, allow_inf_nan=False)] = 1.0
     # the least weight of an emitted packet (emitted_light packets, the analog walk); lighter
     # emissions are made with probability weight / emission_weight and carry emission_weight
     # (kernel/channels/inelastic.py); measured best for packets in clear water

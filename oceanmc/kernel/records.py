@@ -63,6 +63,9 @@ def _record(*fields: str, ints: tuple[str, ...] = (), floats_at: tuple[str, ...]
 #               transfer), channel_transfer ((n_channels - 1) x n_wl x n_wl, excitation-major),
 #               channel_factors ((n_channels - 1) x 2 x n_wl: a then b of a separable
 #               transfer, T_ji = a_j b_i; zeros for one that is not)
+#               hero_cdf (n_wl: the cumulative probabilities of each wavelength being a
+#               spectral photon's hero), hero_k (n_wl: n_wl times them, a new photon's K;
+#               kernel/spectral.py)
 #   int pool:   plane_tally (n_planes; -1: no tally level), segment_layer (n_planes - 1);
 #               comp_start, comp_count (n_layers); comp_model, comp_tab_start, comp_tab_len,
 #               comp_psi_start (n_comps); tab_guide (each table's guide for sampling, at its
@@ -81,7 +84,7 @@ MEDIUM = _record(
                "layer_c_over_b", "layer_settle_path", "up_fraction", "up_density", "up_keep",
                "comp_cumweight", "comp_params", "tab_psi", "tab_q", "tab_cdf", "mix_coef",
                "channel_beta", "channel_sigma", "channel_reach", "channel_transfer",
-               "channel_factors"),
+               "channel_factors", "hero_cdf", "hero_k"),
     ints_at=("plane_tally", "segment_layer", "comp_start", "comp_count", "comp_model",
              "comp_tab_start", "comp_tab_len", "comp_psi_start", "tab_guide", "mix_ptr",
              "mix_comp", "mix_at", "channel_model", "channel_band", "channel_emits",

@@ -2,25 +2,31 @@
 importance sampling (Wilkie et al. 2014, "Hero wavelength spectral sampling", Computer Graphics
 Forum 33(4), 123-131), inside the implicit-capture walk of transport.py.
 
-Each photon draws a hero wavelength h uniformly among the scene's n wavelengths (p.wavelength);
-its path x is sampled exactly as the monochromatic walk at h samples it (free paths with c_h,
-new directions from the phase mixture at h). Every wavelength l scores the path with the
-one-sample multiple-importance estimator and the balance heuristic (Veach 1997, PhD thesis,
-section 9.2.4), the techniques being the n monochromatic walks, each chosen with probability
-1/n:
+Each photon draws a hero wavelength h (p.wavelength) among the scene's n wavelengths with
+probability pi_h (MEDIUM hero_cdf; scene/medium.py hero_probabilities); its path x is sampled
+exactly as the monochromatic walk at h samples it (free paths with c_h, new directions from the
+phase mixture at h). Every wavelength l scores the path with the one-sample multiple-importance
+estimator and the balance heuristic (Veach 1997, PhD thesis, section 9.2.4), the techniques
+being the n monochromatic walks, walk j chosen with probability pi_j:
 
-    F_l(x) = f_l(x) / ((1/n) sum_j p_j(x)) = W_l(x) R_l / mean_j R_j,
+    F_l(x) = f_l(x) / sum_j pi_j p_j(x) = W_l(x) R_l / sum_j pi_j R_j,
 
 with f_l the path's contribution at l, p_j the density with which the walk at j samples x,
 W_l = f_l / p_l the weight the monochromatic walk at l carries on x and R_j = p_j(x) / p_h(x).
-Unbiased: E_h E_x[F_l] = sum_h (1/n) int p_h f_l / mean_j p_j = int f_l. Bound: R_l / mean_j R_j
-<= n, so no wavelength ever weighs more than n times what its own walk would carry on x. (Hero
-probabilities weighted toward the wavelengths whose walks are long, in proportion to
-(1 / (1 - albedo))^a, a = 0.5 or 1, changed the worst band's FOM by no more than the noise of
-its measurement, 6 Case-1 scenes; uniform it stays.)
+Unbiased: E_h E_x[F_l] = sum_h pi_h int p_h f_l / sum_j pi_j p_j = int f_l, for any pi > 0.
+Bound: R_l / sum_j pi_j R_j <= 1 / pi_l, so no wavelength ever weighs more than 1 / pi_l times
+what its own walk would carry on x. pi_j is in proportion to (1 / (1 - w0_j))^a, w0 the top
+layer's single-scattering albedo (estimator.hero_exponent a, 1 by default; 0: uniform): more
+heroes where walks are long, whose paths the short walks of strongly absorbed wavelengths
+sample poorly. Measured (2026-11-28, the spectral bench's 6 Case-1 scenes, 2 interleaved
+rounds against uniform heroes): the water-leaving fraction's worst band gained 1.3-1.8x in
+the three scenes where it was weakest (clear water, blue: its long walks), Rrs nadir's worst
+band stayed 4.5x or more the single-wavelength runs' FOM; a = 1.5 was no better
+(benchmarks/spectral.md compares with uniform heroes).
 
 The walk keeps F_l = p.w G_l / mean_j K_j, with p.w a common factor (the source's weight, the
-surface's, the albedos, roulette) and, per wavelength, K_j (R_j) and G_j:
+surface's, the albedos, roulette) and, per wavelength, G_j and K_j = n pi_j R_j (so that
+mean_j K_j = sum_j pi_j R_j):
 - a collision at scattering angle psi multiplies G_j by beta_j(psi) / beta_h(psi) (the albedo
   times the phase function times the free-path density, b_j p_j / (b_h p_h), the hero's albedo
   going to p.w) and K_j by (c_j p_j) / (c_h p_h): products, no exponential (scatter);
@@ -87,21 +93,28 @@ DEFERRED_EXPONENT_BOUND = 300.0
 
 
 @kernel
-def start(grid, floats, ps, p, from_sky, rng):
+def start(medium, grid, floats, ps, p, from_sky, rng):
     """A new photon: its wavelengths' shares of the source (sun or sky: grid.source_q) and its
-    hero wavelength, drawn uniformly (the reference wavelength starts as the hero)."""
+    hero wavelength h, drawn with probability pi_h (MEDIUM hero_cdf); K_j starts at n pi_j
+    (MEDIUM hero_k), so that mean K is sum_j pi_j R_j along the path. The reference wavelength
+    starts as the hero."""
     n = grid.n_wl
     k, g, last, _ = weights(grid, ps)
     row = grid.source_q + (n if from_sky else 0)
     share = floats[row:row + n]
+    hero_k = floats[medium.hero_k:medium.hero_k + n]
     for j in range(n):
-        k[j] = 1.0
+        k[j] = hero_k[j]
         g[j] = share[j]
         last[j] = 0.0
     ps[free_path_at(grid)] = 0.0
     belong_to(grid, ps, 0)
-    p.wavelength = min(n - 1, int(uniform(rng) * n))
-    p.reference = p.wavelength
+    u = uniform(rng)
+    h = 0
+    while h < n - 1 and u >= floats[medium.hero_cdf + h]:
+        h += 1
+    p.wavelength = h
+    p.reference = h
 
 
 @kernel

@@ -462,7 +462,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         tally = tally_row
         from_air = i < 0 or from_sky or not beam_once
         if with_spectral is not None and grid.n_wl > 1:
-            spectral.start(grid, floats, ps, p, from_sky, rng)
+            spectral.start(medium, grid, floats, ps, p, from_sky, rng)
         if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng,
                                            with_rough_surface):
             continue

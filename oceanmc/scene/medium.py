@@ -113,6 +113,22 @@ def upward_fractions(upward: float | None, albedo: np.ndarray) -> np.ndarray:
     return fraction
 
 
+# 1 - w0 below this counts as this in hero_probabilities: no wavelength has more than 1 / this
+# times the hero probability of the least scattering one
+HERO_LEAST_ABSORBED_FRACTION = 0.01
+
+
+def hero_probabilities(albedo: np.ndarray, exponent: float) -> np.ndarray:
+    """Each wavelength's probability of being a spectral photon's hero (kernel/spectral.py),
+    from the top layer's single-scattering albedo w0 (n_wl): in proportion to
+    (1 / (1 - w0))^exponent, 1 / (1 - w0) being the collisions a monochromatic walk makes
+    there; 1 - w0 is taken as at least HERO_LEAST_ABSORBED_FRACTION. Any positive choice is
+    unbiased (one-sample MIS with the balance heuristic); exponent 0 is uniform."""
+    collisions = 1.0 / np.maximum(HERO_LEAST_ABSORBED_FRACTION, 1.0 - albedo)
+    weight = collisions ** exponent
+    return weight / weight.sum()
+
+
 def settle_paths(layer_c: np.ndarray) -> np.ndarray:
     """Per layer, the free path after which a spectral packet settles whatever its K
     (kernel/spectral.py): the deferred factors exp(-(c_j - c_h) D) stay within
@@ -281,6 +297,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
                           for j in range(n_wl)])                             # (n_wl, n_planes)
     level_tau = plane_tau[:, np.searchsorted(plane_z, depths)]              # (n_wl, n_depths)
     fraction = upward_fractions(upward, albedo)
+    hero_p = hero_probabilities(albedo_all[0], config.estimator.hero_exponent)
     cone = math.radians(config.estimator.upward_cone_deg)
     up_cos = math.cos(cone)
     up_solid_angle = 4.0 * math.pi * math.sin(cone / 2.0) ** 2  # 2 pi (1 - cos A), no cancelling
@@ -297,6 +314,7 @@ def pack(config: cfg.SceneConfig, ed0: np.ndarray | None = None
         layer_inv_c=f.add(np.divide(1.0, layer_c, out=np.zeros_like(layer_c),
                                     where=layer_c > 0.0)),
         layer_albedo=f.add(albedo_all),
+        hero_cdf=f.add(np.cumsum(hero_p)), hero_k=f.add(n_wl * hero_p),
         layer_c_over_b=f.add(np.divide(layer_c, layer_b, out=np.zeros_like(layer_c),
                                        where=layer_b > 0.0)),
         layer_settle_path=f.add(settle_paths(layer_c)),
