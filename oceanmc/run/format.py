@@ -119,9 +119,12 @@ def _write(f: h5py.File, result) -> None:
         write(q.name, q.mean, q.dims, q.units, q.description)
         write(q.name + "_stderr", q.stderr, q.dims, q.units,
               f"standard error of {q.name} over batches")
+        # gzip at level 1 without the shuffle filter: faster to write and smaller than level 4
+        # with it (measured on 20,000-photon runs of configs/: raman_fluorescence.yaml's 12
+        # million values, 70% zeros, 0.49 s and 27.6 MB against 1.06 s and 31.3 MB;
+        # windy_case1.yaml 0.066 s, 3.5 MB against 0.141 s, 4.2 MB)
         ds = write("batches/" + q.name, q.batches, ("batch",) + q.dims, q.units,
-                   f"per-batch values of {q.name}", compression="gzip", compression_opts=4,
-                   shuffle=True)
+                   f"per-batch values of {q.name}", compression="gzip", compression_opts=1)
         ds.attrs["dims"] = ",".join(q.dims)
     if result.resume_state is not None:
         group = f.create_group(RESUME_GROUP)

@@ -158,8 +158,16 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
 
 def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.ndarray:
     """(4, n_alpha): the cap moments (as component_moments) of an inelastic emission's phase
-    function (1 + beta cos^2), the same at every wavelength (kernel/channels/inelastic.py)."""
+    function (1 + beta cos^2), the same at every wavelength (kernel/channels/inelastic.py),
+    remembered within the process and on disk as a layer's are (building the caps' geometry
+    for them took 0.5 s of every start of an inelastic scene)."""
     key = hashlib.sha1(geometry_key + np.array([beta_quadratic]).tobytes()).digest()
+    path = _CAP_DIR / f"emission-{key.hex()}.npy"
+    if key not in _COMPONENT_MOMENTS and path.exists():
+        try:
+            _COMPONENT_MOMENTS[key] = np.load(path)
+        except (OSError, ValueError):
+            pass   # unreadable: computed again below
     if key not in _COMPONENT_MOMENTS:
         params = np.array([beta_quadratic])
         table = cap_tables.cumulative(
@@ -167,6 +175,7 @@ def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.nda
                 [quadratic.evaluate(params, math.cos(a)) for a in angles]), np.zeros(0))
         water, air = caps()
         _COMPONENT_MOMENTS[key] = np.array([*water.moments(table), *air.moments(table)])
+        _save(path, _COMPONENT_MOMENTS[key])
     return _COMPONENT_MOMENTS[key]
 
 
