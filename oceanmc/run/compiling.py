@@ -40,7 +40,12 @@ changes, 26.4-27.9 s after the first and 26.0-27.1 s after both (interleaved, 3 
 component_density here after the collision, whose phase functions it shares, 26.9-27.7 s).
 Now (ready(), empty cache, twice; kernel bcac4d9) the child exits at 12.7-13.1 s, the
 collision is compiled at 13.3-13.8 s and trace_batch takes 9.2-9.5 s more: the two halves are
-balanced, and what is left is the collision's and trace_batch's own compilation. Kernel
+balanced, and what is left is the collision's and trace_batch's own compilation. (Sharing the
+events out by claims, the child taking them from the longest, this process the rest once its
+collision was compiled: tried 2026-11-28 on a quiet machine, kernel 9b845d7; the child had
+every event compiled by the time the collision was, 5-6 s, for the spectral, bottom and
+rough-sea variants, and cold `oceanmc run CONFIG --photons 20000`, interleaved, twice, moved
+by -1.4 to +0.9 s: not kept.) Kernel
 e4782e8's vectorised cap scores, emission bands and carried shares added 4-5 s (one process:
 32.3 s against 37.5 s, trace_batch +1.8 s, the cap scores +1.3 s, the collision +0.7 s; ready(),
 interleaved: 23.7-24.8 s against 27.5-29.1 s); kernel c484c1c's exp (kernel/exp.py, in five loops)
