@@ -75,6 +75,15 @@ def _save(path: Path, table: np.ndarray) -> None:
         pass   # another run pruned the same file first
 
 
+def _load_into(kept: dict, key: bytes, path: Path) -> None:
+    """kept[key] from the disk cache's file `path`, where it is there and readable (else the
+    caller computes it again)."""
+    try:
+        kept[key] = np.load(path)
+    except (OSError, ValueError):
+        pass
+
+
 def component_table(m, mf: np.ndarray, mi: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
     """(psi, q) of phase function component k's table in the pools (empty for an analytic
     component; tables on one angle grid share its psi: kernel/phase/dispatch.py table_at)."""
@@ -131,11 +140,8 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
     built only if some table is), remembered by key (the phase functions' content and the
     geometry) within the process and on disk."""
     path = _CAP_DIR / f"{key.hex()}.npy"
-    if key not in _CAP_CACHE and path.exists():
-        try:
-            _CAP_CACHE[key] = np.load(path)
-        except (OSError, ValueError):
-            pass   # unreadable: computed again below
+    if key not in _CAP_CACHE:
+        _load_into(_CAP_CACHE, key, path)
     if key not in _CAP_CACHE:
         m = medium[0]
         first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
@@ -163,11 +169,8 @@ def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.nda
     for them took 0.5 s of every start of an inelastic scene)."""
     key = hashlib.sha1(geometry_key + np.array([beta_quadratic]).tobytes()).digest()
     path = _CAP_DIR / f"emission-{key.hex()}.npy"
-    if key not in _COMPONENT_MOMENTS and path.exists():
-        try:
-            _COMPONENT_MOMENTS[key] = np.load(path)
-        except (OSError, ValueError):
-            pass   # unreadable: computed again below
+    if key not in _COMPONENT_MOMENTS:
+        _load_into(_COMPONENT_MOMENTS, key, path)
     if key not in _COMPONENT_MOMENTS:
         params = np.array([beta_quadratic])
         table = cap_tables.cumulative(
