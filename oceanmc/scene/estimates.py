@@ -75,13 +75,18 @@ def _save(path: Path, table: np.ndarray) -> None:
         pass   # another run pruned the same file first
 
 
-def _load_into(kept: dict, key: bytes, path: Path) -> None:
-    """kept[key] from the disk cache's file `path`, where it is there and readable (else the
-    caller computes it again)."""
-    try:
-        kept[key] = np.load(path)
-    except (OSError, ValueError):
-        pass
+def _remembered(kept: dict, key: bytes, path: Path, compute) -> np.ndarray:
+    """kept[key]: from the process's memory, else from the disk cache's file `path` where it is
+    there and readable, else compute() (then kept there too); the newest 64 kept in memory."""
+    if key not in kept:
+        try:
+            kept[key] = np.load(path)
+        except (OSError, ValueError):   # missing or unreadable: computed again
+            kept[key] = compute()
+            _save(path, kept[key])
+        if len(kept) > 64:
+            kept.pop(next(iter(kept)))
+    return kept[key]
 
 
 def component_table(m, mf: np.ndarray, mi: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -139,10 +144,7 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
     layer's phase function at each wavelength (caps(): the two caps' cap_tables.cap_geometry,
     built only if some table is), remembered by key (the phase functions' content and the
     geometry) within the process and on disk."""
-    path = _CAP_DIR / f"{key.hex()}.npy"
-    if key not in _CAP_CACHE:
-        _load_into(_CAP_CACHE, key, path)
-    if key not in _CAP_CACHE:
+    def mixed() -> np.ndarray:
         m = medium[0]
         first, count = mi[m["comp_start"] + layer], mi[m["comp_count"] + layer]
         n_wl, n_comps = int(m["n_wl"]), int(m["n_comps"])
@@ -154,12 +156,9 @@ def layer_cap_moments(medium, mf, mi, layer: int, caps, key: bytes,
         cumulative = mf[m["comp_cumweight"]:m["comp_cumweight"] + n_wl * n_comps].reshape(
             n_wl, n_comps)[:, first:first + count]
         shares = np.diff(cumulative, axis=1, prepend=0.0)              # (n_wl, count)
-        out = np.einsum("wk,kma->maw", shares, parts)
-        _CAP_CACHE[key] = out
-        _save(path, out)
-        if len(_CAP_CACHE) > 64:
-            _CAP_CACHE.pop(next(iter(_CAP_CACHE)))
-    return _CAP_CACHE[key]
+        return np.einsum("wk,kma->maw", shares, parts)
+
+    return _remembered(_CAP_CACHE, key, _CAP_DIR / f"{key.hex()}.npy", mixed)
 
 
 def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.ndarray:
@@ -168,18 +167,16 @@ def emission_moments(beta_quadratic: float, caps, geometry_key: bytes) -> np.nda
     remembered within the process and on disk as a layer's are (building the caps' geometry
     for them took 0.5 s of every start of an inelastic scene)."""
     key = hashlib.sha1(geometry_key + np.array([beta_quadratic]).tobytes()).digest()
-    path = _CAP_DIR / f"emission-{key.hex()}.npy"
-    if key not in _COMPONENT_MOMENTS:
-        _load_into(_COMPONENT_MOMENTS, key, path)
-    if key not in _COMPONENT_MOMENTS:
+
+    def moments() -> np.ndarray:
         params = np.array([beta_quadratic])
         table = cap_tables.cumulative(
             lambda angles: 2.0 * math.pi * np.sin(angles) * np.array(
                 [quadratic.evaluate(params, math.cos(a)) for a in angles]), np.zeros(0))
         water, air = caps()
-        _COMPONENT_MOMENTS[key] = np.array([*water.moments(table), *air.moments(table)])
-        _save(path, _COMPONENT_MOMENTS[key])
-    return _COMPONENT_MOMENTS[key]
+        return np.array([*water.moments(table), *air.moments(table)])
+
+    return _remembered(_COMPONENT_MOMENTS, key, _CAP_DIR / f"emission-{key.hex()}.npy", moments)
 
 
 # The rough sea's lobe K is about (n - 1) alpha wide in the air (alpha the Beckmann roughness,
