@@ -116,12 +116,11 @@ def add_to_levels(est, floats, ints, grid, tally, share, z, tau_here, k, base, m
     n = grid.n_wl
     row = est.n_dirs * n     # one level's scores: direction-major, wavelength fastest
     local = grid.local + k * n
-    taus = grid.level_tau + j * grid.n_depths
     if ints[est.in_water + k]:
         for level in range(grid.n_depths):
             if floats[grid.level_z + level] <= z:
                 deposit(grid, tally, share, local + level * row, j, base * math.exp(
-                    -(tau_here - floats[taus + level]) / mu))
+                    -(tau_here - floats[grid.level_tau + level * n + j]) / mu))
     factor = floats[est.air_factor + k]
     if factor > 0.0:
         deposit(grid, tally, share, local + grid.n_depths * row, j,
@@ -232,11 +231,15 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
     # surface), the point scores with probability t / CAP_ROULETTE and its scores are
     # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
     # which send almost nothing up, cost a comparison instead of n_wl table reads
-    nearest = grid.level_tau + above - 1
     least = math.inf
-    for j in range(first, last):
-        dtau = tau[j] - (floats[nearest + j * grid.n_depths] if above > 0 else 0.0)
-        least = min(least, dtau)
+    if above > 0:
+        at = grid.level_tau + (above - 1) * n + first
+        nearest = floats[at:at + last - first]
+        for j in range(last - first):
+            least = min(least, tau[first + j] - nearest[j])
+    else:
+        for j in range(first, last):
+            least = min(least, tau[j])
     scale = 1.0
     kept = math.exp(-least)
     if kept < CAP_ROULETTE:
@@ -296,12 +299,11 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         level_t = to_level[first:last]
         for j in range(count):
             carried[j] = level_t[j]
-        depths = grid.n_depths
         for level in range(above - 1, -1, -1):
-            # this level's optical depth and decay at each wavelength (stride n_depths)
-            at = first * depths + level
-            level_tau = floats[grid.level_tau + at:grid.level_tau + at + count * depths:depths]
-            decay = floats[est.level_decay + at:est.level_decay + at + count * depths:depths]
+            # this level's optical depth and decay at each wavelength
+            at = level * n + first
+            level_tau = floats[grid.level_tau + at:grid.level_tau + at + count]
+            decay = floats[est.level_decay + at:est.level_decay + at + count]
             for j in range(count):
                 value[j] = water_cap_score(w[j] * water_factor, carried[j],
                                            g * m0_lo[j] + f * m0_hi[j],
@@ -345,7 +347,7 @@ def transmissions(est, floats, grid, tau_here, above, j):
     to_air = math.exp(-tau_here / est.mu_a)
     if above == 0:
         return 0.0, to_air
-    return math.exp(-(tau_here - floats[grid.level_tau + j * grid.n_depths + above - 1])
+    return math.exp(-(tau_here - floats[grid.level_tau + (above - 1) * grid.n_wl + j])
                     / est.mu_w), to_air
 
 
@@ -363,8 +365,8 @@ def spectral_transmissions(est, floats, grid, tau, above, first, last, to_level,
     if above == 0:
         level_t[:] = 0.0
         return
-    at = grid.level_tau + first * grid.n_depths + above - 1
-    nearest = floats[at:at + count * grid.n_depths:grid.n_depths]
+    at = grid.level_tau + (above - 1) * grid.n_wl + first
+    nearest = floats[at:at + count]
     for j in range(count):
         level_t[j] = exp(-(tau_j[j] - nearest[j]) / est.mu_w)
 
@@ -466,11 +468,10 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, 
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
         f = toward(model, bp, floats, 0, ux, uy, uz, ox, oy, -oz)
         for j in range(first, last):
-            taus = grid.level_tau + j * grid.n_depths
             for level in range(grid.n_depths):
                 if floats[grid.level_z + level] <= z:
                     deposit(grid, tally, share, grid.cap + level * n, j, weight[j] * f * math.exp(
-                        -(tau[j] - floats[taus + level]) / mu))
+                        -(tau[j] - floats[grid.level_tau + level * n + j]) / mu))
         n_water = surface.n_water
         mu_a = 1.0 - uniform(rng) * (1.0 - est.cos_air)
         if with_rough_surface is not None and surface.delta == 0:

@@ -116,7 +116,9 @@ SKY = _record(
 #   levels: the in-water tally depths (n_depths), then air (0+, all light), then air_leaving
 #   (0+, water-leaving light only).
 #   float pool: theta_mu_edges (n_theta + 1, falling from 1 to -1), phi_edge_cos,
-#               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_wl x n_depths),
+#               phi_edge_sin (n_phi), level_z (n_depths), level_tau (n_depths x n_wl:
+#               a level's wavelengths side by side, which the cap scores read as one
+#               contiguous row),
 #               source_q (2 x n_wl: sun, sky), bottom_q (2 x n_wl: every lobe, a
 #               lambertian_specular bottom's mirror lobe) (kernel/spectral.py)
 #   int pool:   theta_lookup (n_lookup), theta_is_cap (n_theta)
@@ -146,7 +148,7 @@ GRID = _record(
 #               (n_tables x n_alpha x n_wl each; a table holds all wavelengths of a layer;
 #               after the layers' tables, one per inelastic channel's emission, from
 #               emission_tables on),
-#               level_decay (n_wl x n_depths)
+#               level_decay (n_depths x n_wl, as level_tau)
 #   int pool:   in_water (n_dirs), table_of_layer (n_layers)
 ESTIMATES = _record(
     "directions_on", "cap_on", "n_dirs", "n_alpha",
@@ -204,8 +206,9 @@ def work_size(n_wl: int, n_parts: int = 1) -> int:
     (kernel/channels/inelastic.py); last, the event's cap
     transmissions, to the level above and to 0+, and whether they are computed yet
     (local_estimate.cap_transmissions), and a cap score's values and the transmissions it
-    carries up (local_estimate.cap_scratch)."""
-    return (8 + max(0, n_parts - 1)) * n_wl + 1
+    carries up (local_estimate.cap_scratch); with inelastic light, then the hero's posterior at
+    a collision (spectral.posterior_at)."""
+    return (8 if n_parts == 1 else 8 + n_parts) * n_wl + 1
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

@@ -235,7 +235,7 @@ def phase_values(medium, floats, ints, layer, cos_psi, out):
 
 
 @kernel
-def collision_density(medium, floats, grid, ps, p, layer, weight):
+def collision_density(medium, floats, grid, ps, p, layer, weight, posterior):
     """What a collision of the packet carries per unit coefficient at each wavelength, without
     settling: times a wavelength's scattering coefficient b_j it is what the collision
     scatters (collision_weights), times an inelastic process's coefficient what that process
@@ -243,7 +243,12 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     settle would make F_j = p.w s G_j e_j / mean_k(K_k e_k) (s = exp((c_r - c_h) D), what p.w
     took of the reference's), and adding the collision point to the path gives each K_k the
     factor c_k (its collision density), so weight_j = p.w s G_j e_j / mean_k(K_k e_k c_k) (the
-    mean of K e cancels; one wavelength: w / c, the implicit-capture weight per unit b)."""
+    mean of K e cancels; one wavelength: w / c, the implicit-capture weight per unit b).
+    Unless `posterior` is empty: also the probability that each wavelength is the hero, given
+    the path so far and the collision point, K_j e_j c_j / sum_k K_k e_k c_k, into it (n_wl;
+    direction_density averages over it). A packet that carries emissions on needs it, and
+    takes it here without settling: its one settle comes when it has turned
+    (channels/inelastic.py carry)."""
     n = grid.n_wl
     k, g, _, _ = weights(grid, ps)
     row = medium.layer_c + layer * n
@@ -253,34 +258,31 @@ def collision_density(medium, floats, grid, ps, p, layer, weight):
     if dist > 0.0:
         for j in range(n):
             weight[j] = exp(-(c[j] - c_h) * dist)
-    else:   # settled (a collision whose emissions the packet carries on)
+    else:   # settled, nothing deferred
         for j in range(n):
             weight[j] = 1.0
     total = 0.0
-    for j in range(n):
-        total += k[j] * weight[j] * c[j]
+    if posterior.shape[0] > 0:
+        for j in range(n):
+            density = k[j] * weight[j] * c[j]
+            posterior[j] = density
+            total += density
+        per_total = 1.0 / total
+        for j in range(n):
+            posterior[j] *= per_total
+    else:
+        for j in range(n):
+            total += k[j] * weight[j] * c[j]
     scale = p.w * math.exp((c[p.reference] - c_h) * dist) * n / total
     for j in range(n):
         weight[j] *= scale * g[j]
 
 
-@kernel
-def hero_posterior(medium, floats, grid, ps, layer, out):
-    """At a collision of a settled packet: the probability that each wavelength is the hero,
-    given the path so far (its density K_j with the collision point's c_j, over their sum),
-    into out (n_wl). Averaged over it, the hero's direction density is the density of the
-    direction the walk draws next (direction_density)."""
-    n = grid.n_wl
-    k, _, _, _ = weights(grid, ps)
-    row = medium.layer_c + layer * n
-    c = floats[row:row + n]
-    total = 0.0
-    for j in range(n):
-        out[j] = k[j] * c[j]
-        total += out[j]
-    per_total = 1.0 / total
-    for j in range(n):
-        out[j] *= per_total
+@internal
+def posterior_at(grid):
+    """Where the hero's posterior at a collision (collision_density; n_wl) lies in the
+    scratch row, last (records.work_size); a scene without inelastic light has none."""
+    return (7 + grid.n_parts) * grid.n_wl + 1
 
 
 @kernel

@@ -220,17 +220,18 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
     # of NoneType, not on a variable computed from one; kernel/variants.py)
     estimates = (est.directions_on or est.cap_on) and albedo > 0.0
     # the packet carries its collisions' emissions on where it goes on with its weight
-    # (channels/inelastic.py); settled first, so that the hero's posterior is exact
+    # (channels/inelastic.py), with the hero's posterior at the collision
     carrying = (medium.n_channels > 1 and ctrl.carry_emissions != 0 and not ctrl.analog
                 and albedo > 0.0)
-    if with_inelastic is not None and with_spectral is not None and carrying:
-        spectral.settle(medium, floats, grid, tally, ps, p, layer)
     if with_spectral is not None and grid.n_wl > 1 and (
             (with_local_estimates is not None and estimates)
             or (with_inelastic is not None and medium.n_channels > 1)):
         # the collision's weight per unit coefficient at every wavelength, which the local
         # estimates (times b) and the inelastic channels (times theirs) read
-        spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl])
+        at = spectral.posterior_at(grid)
+        spectral.collision_density(medium, floats, grid, ps, p, layer, work[:grid.n_wl],
+                                   work[at:at + grid.n_wl if with_inelastic is not None
+                                        and carrying else at])
     if with_inelastic is not None and grid.n_parts > 1:
         # a new point: its cap transmissions are not computed yet
         # (local_estimate.cap_transmissions)
@@ -245,9 +246,6 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
         n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
                                   stack, stack_ps, n_stacked, p, ps, layer, carrying,
                                   rng_emitted, with_rough_surface, with_local_estimates)
-    if with_inelastic is not None and with_spectral is not None and carrying:
-        spectral.hero_posterior(medium, floats, grid, ps, layer,
-                                work[grid.n_wl:2 * grid.n_wl])
     w = p.w
     budget = grid.budget
     if ctrl.analog:

@@ -286,7 +286,7 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
         # transmission along mu_w from each level to the one above it (the first: unused),
         # per wavelength (n_wl x n_depths)
         level_decay=f.add(np.exp(-np.diff(level_tau, axis=1, prepend=level_tau[:, :1])
-                                 / mu_w)),
+                                 / mu_w).T),
         in_water=i.add(in_water), table_of_layer=i.add(table_of_layer),
         emission_tables=emission_tables)
     return rec, f.array(), i.array()

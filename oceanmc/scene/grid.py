@@ -135,7 +135,7 @@ def pack(config: cfg.SceneConfig, depths: np.ndarray, level_tau: np.ndarray,
         n_lookup=THETA_LOOKUP_CELLS, theta_cols=theta_cols, phi_cols=phi_cols,
         theta_mu_edges=f.add(mu), phi_edge_cos=f.add(np.cos(np.radians(grid.phi_edges[:-1]))),
         phi_edge_sin=f.add(np.sin(np.radians(grid.phi_edges[:-1]))),
-        level_z=f.add(depths), level_tau=f.add(level_tau),
+        level_z=f.add(depths), level_tau=f.add(level_tau.T),
         theta_lookup=i.add(theta_lookup(mu)), theta_is_cap=i.add(grid.is_cap),
         n_dirs=n_dirs, n_budget=n_budget, part_size=size, **layout)
     return rec, f.array(), i.array(), grid

@@ -25,6 +25,7 @@ def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
     each starts a packet of its own. Returns the new stack height."""
     if medium.n_channels == 1:
         return n_stacked
+    inelastic.book_takes(medium, grid, floats, tally_row, work, ps, layer)
     for channel in range(1, medium.n_channels):
         n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
                                    tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,

@@ -16,7 +16,7 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
             with_spectral):
     """The packet's new direction, and its weights for it (see channels/__init__.py).
     carrying: the packet carries a collision's emissions on (channels/inelastic.py carry),
-    and work[n_wl:2 n_wl] holds the hero's posterior (spectral.hero_posterior); returns the
+    and the scratch holds the hero's posterior (spectral.posterior_at); returns the
     density with which the direction was drawn, averaged over it (1/sr; else 0)."""
     ux, uy, uz = p.ux, p.uy, p.uz
     h = p.wavelength
@@ -50,7 +50,8 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
                                  angle, psi_s, node_s, keep, cone_density, ctrl.analog != 0)
         if carrying:
             n = grid.n_wl
-            density = spectral.direction_density(medium, floats, grid, work[n:2 * n],
+            at = spectral.posterior_at(grid)
+            density = spectral.direction_density(medium, floats, grid, work[at:at + n],
                                                  work[:n], layer, angle, keep, cone_density)
     elif ctrl.upward:
         p.w = upward.weight(medium, floats, ints, layer, p.w, ux * nx + uy * ny + uz * nz, nz)
