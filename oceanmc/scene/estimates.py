@@ -284,7 +284,7 @@ def pack(config: cfg.SceneConfig, medium: np.ndarray, mf: np.ndarray, mi: np.nda
         **{f"cap_{name}": f.add(np.array([t[m] for t in moments]))
            for m, name in enumerate(("m0w", "m1w", "m0a", "m1a"))},
         # transmission along mu_w from each level to the one above it (the first: unused),
-        # per wavelength (n_wl x n_depths)
+        # per wavelength (n_depths x n_wl: a level's wavelengths side by side)
         level_decay=f.add(np.exp(-np.diff(level_tau, axis=1, prepend=level_tau[:, :1])
                                  / mu_w).T),
         in_water=i.add(in_water), table_of_layer=i.add(table_of_layer),
