@@ -164,9 +164,11 @@ def test_channel_registry_and_dispatch():
         p.w, p.ux, p.uy, p.uz, p.z, p.seg = 1.0, 0.0, 0.0, 1.0, 0.5, 0
         spectral.collision_density(medium[0], floats, grid[0], ps, p, 0,
                                    work[:grid[0].n_wl], work[:0])
-        # (with_rough_surface, with_local_estimates: compiled in; kernel/variants.py)
+        # (with_rough_surface, with_facet_walk, with_local_estimates, with_exact_directions:
+        # compiled in; kernel/variants.py)
         return channels.emit(medium[0], surface[0], ctrl[0], grid[0], est[0], floats, ints,
-                             tally, work, stack, stack_ps, 0, p, ps, 0, False, rng, True, True)
+                             tally, work, stack, stack_ps, 0, p, ps, 0, False, rng, True, True,
+                             True, True)
 
     inelastic = {"raman": {"b488_per_m": 0.05}, "chlorophyll_fluorescence": {}}
     sc = scene.build(oceanmc.load_config({

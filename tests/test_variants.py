@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from oceanmc.config import load_config
-from oceanmc.kernel.variants import EVERYTHING, PARTS, Variant, union
+from oceanmc.kernel.variants import EVERYTHING, PARTS, REFINES, Variant, union
 from oceanmc.scene import predicted_variant
 
 REPO = Path(__file__).resolve().parents[1]
@@ -21,11 +21,18 @@ TIMING = {"wall_time_s", "startup_time_s", "photons_per_s", "threads"}
 
 def test_supersets_are_the_variants_that_hold_it_nearest_first():
     plain = Variant(*(False,) * len(PARTS))
-    assert len(plain.supersets()) == 2 ** len(PARTS)
+    # each refinement and the part it refines: off, the part alone, or both
+    consistent = 2 ** (len(PARTS) - 2 * len(REFINES)) * 3 ** len(REFINES)
+    assert len(plain.supersets()) == consistent
+    assert all(v.consistent for v in plain.supersets())
     assert plain.supersets()[0] == plain and plain.supersets()[-1] == EVERYTHING
+    walk = plain._replace(rough_surface=True, facet_walk=True)
+    assert not plain._replace(facet_walk=True).consistent and walk.consistent
+    assert all(v.rough_surface and v.facet_walk for v in walk.supersets())
+    assert walk in plain._replace(rough_surface=True).supersets()
     spectral = plain._replace(spectral=True)
     found = spectral.supersets()
-    assert found[0] == spectral and len(found) == 2 ** (len(PARTS) - 1)
+    assert found[0] == spectral and len(found) == consistent // 2
     assert all(v.holds(spectral) for v in found)
     assert [sum(v) for v in found] == sorted(sum(v) for v in found)
     assert not plain.holds(spectral) and EVERYTHING.holds(plain)
@@ -79,3 +86,36 @@ def test_own_variant_setting_admits_only_the_scenes_own(monkeypatch):
     monkeypatch.setenv(compiling.OWN_VARIANT_ENV, "1")
     assert compiling._candidates(spectral) == [spectral]
     assert compiling._here(spectral) is None
+
+
+@pytest.mark.parametrize("changes, parts", [
+    ({"surface": {"model": "cox_munk", "wind_speed_m_s": 7.0, "method": "walk"}},
+     {"rough_surface", "facet_walk"}),
+    ({"surface": {"model": "cox_munk", "wind_speed_m_s": 7.0, "method": "table"}},
+     {"rough_surface"}),
+    ({"bottom": {"model": "lambertian", "reflectance": 0.2}}, {"reflecting_bottom"}),
+    ({"bottom": {"model": "lambertian", "reflectance": 0.2, "sampling": "tabulated"}},
+     {"reflecting_bottom", "detailed_bottom"}),
+    ({"bottom": {"model": "mixture", "components": [
+        {"model": "minnaert", "k": 0.8, "fraction": 0.5, "reflectance": 0.1},
+        {"model": "minnaert", "k": 0.8, "fraction": 0.5, "reflectance": 0.3}]}},
+     {"reflecting_bottom"}),
+    ({"bottom": {"model": "ggx", "roughness": 0.3}},
+     {"reflecting_bottom", "detailed_bottom"}),
+    ({"tallies": {"local_directions_deg": [[180, 0]]}}, {"local_estimates", "exact_directions"}),
+])
+def test_each_refinement_is_predicted_from_the_config_as_the_packed_scene_uses_it(changes,
+                                                                                 parts):
+    """The facet walk (surface.method: walk), bottoms beyond the closed-form four (or sampled by
+    table) and the exact directions are parts of their own: the config's prediction, which the
+    cold start compiles, is the packed scene's own variant."""
+    from oceanmc.scene import build
+    base = {"water": {"layers": [{"thickness_m": 5.0, "a": 0.1, "b": 0.5}]},
+            "bottom": {"model": "black"},
+            "tallies": {"depths_m": [0], "nadir_estimator": "crossing"}}
+    for key, value in changes.items():
+        base[key] = {**base[key], **value} if key == "tallies" else value
+    config = load_config(base)
+    predicted = predicted_variant(config)
+    assert predicted == build(config).variant
+    assert {part for part, on in zip(PARTS, predicted) if on} == parts

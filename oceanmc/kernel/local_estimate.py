@@ -128,7 +128,7 @@ def add_to_levels(est, floats, ints, grid, tally, share, z, tau_here, k, base, m
 
 
 @internal
-def from_air_through_rough(surface, floats, ax, ay, az, rng):
+def from_air_through_rough(surface, floats, ax, ay, az, rng, with_facet_walk):
     """(ix, iy, iz, t): for the upward air direction o = (ax, ay, -az) (az > 0), an in-water
     direction of travel i whose light the rough surface sends into o, with t = 1, or t = 0
     (nothing sent): one sample of the rough surface (its table, or its facet walk) for a photon
@@ -137,12 +137,12 @@ def from_air_through_rough(surface, floats, ax, ay, az, rng):
     tests/test_surface_table.py) the radiance L(o) at 0+ is the expectation of
     t L_water(i) / n^2."""
     ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, -ax, -ay, az, uniform(rng),
-                                                          rng, floats)
+                                                          rng, floats, with_facet_walk)
     return -ox, -oy, -oz, weight if transmitted else 0.0
 
 
 @internal
-def into_water_through_rough(surface, est, floats, k, rng):
+def into_water_through_rough(surface, est, floats, k, rng, with_facet_walk):
     """from_air_through_rough for air row k (its upward air direction stored as its
     flat-surface refracted in-water direction); the row's air factor 1/n^2 completes it."""
     dx, dy, dz = direction(est, floats, k)
@@ -150,7 +150,8 @@ def into_water_through_rough(surface, est, floats, k, rng):
     ax = n * dx
     ay = n * dy
     return from_air_through_rough(surface, floats, ax, ay,
-                                  math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay)), rng)
+                                  math.sqrt(max(0.0, 1.0 - ax * ax - ay * ay)), rng,
+                                  with_facet_walk)
 
 
 @internal
@@ -165,7 +166,7 @@ def collision_depths(medium, floats, grid, work, p, layer):
 
 @internal
 def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, layer,
-                 w_scattered, rng, with_rough_surface):
+                 w_scattered, rng, with_rough_surface, with_facet_walk, with_exact_directions):
     """What one collision of packet p (scattered weight w_scattered in a one-wavelength scene;
     in a spectral walk its weight per unit coefficient at each wavelength in work[:n_wl],
     spectral.collision_density; the point's optical depths in the scratch, collision_depths)
@@ -180,12 +181,13 @@ def at_collision(est, grid, medium, surface, floats, ints, tally, ps, work, p, l
         spectral.collision_weights(medium, floats, grid, layer, work[:n], weight)
     z = p.z
     ux, uy, uz = p.ux, p.uy, p.uz
-    if est.directions_on:
+    if with_exact_directions is not None and est.directions_on:
         rough = surface.delta == 0
         for k in range(est.n_dirs):
             factor = floats[est.air_factor + k]
             if with_rough_surface is not None and rough and factor > 0.0:
-                ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
+                ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng,
+                                                         with_facet_walk)
                 if t > 0.0 and iz < 0.0:
                     layer_phase(medium, floats, ints, grid, layer, ux * ix + uy * iy + uz * iz,
                                 phase_j)
@@ -372,7 +374,7 @@ def spectral_transmissions(est, floats, grid, tau, above, first, last, to_level,
 
 
 @internal
-def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz):
+def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz, with_detailed_bottom):
     """What a point source sends per unit weight toward the travel direction (ox, oy, oz)
     (world frame, upward): a bottom of BRDF `model` (model >= 0; the packet travelling (ux, uy,
     uz), in the BRDF's local frame (x, -y, -z) as brdf.dispatch.reflect) its f in 1/sr; an
@@ -380,13 +382,13 @@ def toward(model, bp, floats, beta_at, ux, uy, uz, ox, oy, oz):
     floats[beta_at], about the packet's direction, over |oz| (a volume source: the radiance of
     the light it sends grows as the path crosses a plane more obliquely, as a collision's)."""
     if model >= 0:
-        return brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, -oz)
+        return brdf.evaluate_local(model, bp, -ux, uy, uz, ox, -oy, -oz, with_detailed_bottom)
     return quadratic.evaluate(floats[beta_at:], ux * ox + uy * oy + uz * oz) / -oz
 
 
 @internal
 def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, work, p, rng,
-              with_rough_surface):
+              with_rough_surface, with_facet_walk, with_detailed_bottom, with_exact_directions):
     """Packet p meets the bottom: the reflected radiance w f(wi, W) T in the exact directions
     and the polar-cap averages (from_point), at every wavelength (one BRDF shape, each
     wavelength's reflectance share in its weight)."""
@@ -401,12 +403,12 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
         tau[j] = floats[medium.plane_tau + j * medium.n_planes + bottom_plane]
     from_point(est, grid, surface, floats, ints, bp, tally, weights(grid, ps)[3], weight, tau,
                floats[medium.plane_z + bottom_plane], p.ux, p.uy, p.uz, bottom.model, rng,
-               with_rough_surface)
+               with_rough_surface, with_facet_walk, with_detailed_bottom, with_exact_directions)
 
 
 @internal
 def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, table,
-                first, last, rng, with_rough_surface):
+                first, last, rng, with_rough_surface, with_facet_walk, with_exact_directions):
     """An inelastic emission at packet p's collision (its weights at each wavelength in
     work[3 n:4 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
     beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
@@ -416,10 +418,11 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
     weight = work[3 * n:4 * n]
     tau = scratch(grid, work)[1]   # the collision's (collision_depths)
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
-    if est.directions_on:
+    if with_exact_directions is not None and est.directions_on:
+        # (an emission's: no BRDF, with_detailed_bottom None)
         directions_from_point(est, grid, surface, floats, ints, floats, tally, one_part, weight,
                               tau, p.z, p.ux, p.uy, p.uz, -1, beta_at, first, last, rng,
-                              with_rough_surface)
+                              with_rough_surface, with_facet_walk, None)
     if est.cap_on:
         cap_scores(est, grid, floats, ints, tally, one_part, work, weight, tau, p.z, p.uz,
                    table, first, last, rng)
@@ -427,7 +430,8 @@ def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer,
 
 @internal
 def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z,
-                          ux, uy, uz, model, beta_at, first, last, rng, with_rough_surface):
+                          ux, uy, uz, model, beta_at, first, last, rng, with_rough_surface,
+                          with_facet_walk, with_detailed_bottom):
     """The radiance a point source at depth z (optical depths tau, weights `weight` at the
     wavelengths first .. last - 1, none elsewhere; toward() says what it sends, a bottom's
     BRDF or an emission's phase function) sends in the exact directions."""
@@ -436,16 +440,18 @@ def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, we
     for k in range(est.n_dirs):
         factor = floats[est.air_factor + k]
         if with_rough_surface is not None and rough and factor > 0.0:
-            ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng)
+            ix, iy, iz, t = into_water_through_rough(surface, est, floats, k, rng,
+                                                     with_facet_walk)
             if t > 0.0 and iz < 0.0:
-                f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz)
+                f = toward(model, bp, floats, beta_at, ux, uy, uz, ix, iy, iz,
+                           with_detailed_bottom)
                 at = grid.local + (grid.n_depths * est.n_dirs + k) * n
                 for j in range(first, last):
                     deposit(grid, tally, share, at, j,
                             weight[j] * f * t * math.exp(tau[j] / iz) * factor)
             continue
         dx, dy, dz = direction(est, floats, k)
-        f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz)
+        f = toward(model, bp, floats, beta_at, ux, uy, uz, dx, dy, dz, with_detailed_bottom)
         for j in range(first, last):
             add_to_levels(est, floats, ints, grid, tally, share, z, tau[j], k, weight[j] * f,
                           -dz, j)
@@ -453,20 +459,22 @@ def directions_from_point(est, grid, surface, floats, ints, bp, tally, share, we
 
 @internal
 def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, z, ux, uy, uz,
-               model, rng, with_rough_surface):
+               model, rng, with_rough_surface, with_facet_walk, with_detailed_bottom,
+               with_exact_directions):
     """The radiance the bottom (BRDF `model`) at depth z sends in the exact directions
     (directions_from_point), and the polar-cap average from one direction W drawn uniformly in
     the cap (an unbiased estimate of the cap average; f is bounded for every non-mirror BRDF),
     once in water and once for the air cap, through the surface's transmittance."""
     n = grid.n_wl
     first, last = 0, n
-    if est.directions_on:
+    if with_exact_directions is not None and est.directions_on:
         directions_from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau,
-                              z, ux, uy, uz, model, 0, first, last, rng, with_rough_surface)
+                              z, ux, uy, uz, model, 0, first, last, rng, with_rough_surface,
+                              with_facet_walk, with_detailed_bottom)
     if est.cap_on:
         mu = 1.0 - uniform(rng) * (1.0 - est.cos_water)
         ox, oy, oz = from_angles(mu, 2.0 * math.pi * uniform(rng))
-        f = toward(model, bp, floats, 0, ux, uy, uz, ox, oy, -oz)
+        f = toward(model, bp, floats, 0, ux, uy, uz, ox, oy, -oz, with_detailed_bottom)
         for j in range(first, last):
             for level in range(grid.n_depths):
                 if floats[grid.level_z + level] <= z:
@@ -478,10 +486,11 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, 
             # the air cap's direction drawn uniformly, its light traced back through the
             # rough sea to one in-water direction (unbiased for the cap average)
             ax, ay, _ = from_angles(mu_a, 2.0 * math.pi * uniform(rng))
-            ix, iy, iz, t = from_air_through_rough(surface, floats, ax, ay, mu_a, rng)
+            ix, iy, iz, t = from_air_through_rough(surface, floats, ax, ay, mu_a, rng,
+                                                   with_facet_walk)
             if t > 0.0 and iz < 0.0:
-                f = toward(model, bp, floats, 0, ux, uy, uz, ix, iy, iz) * t / (
-                    n_water * n_water)
+                f = toward(model, bp, floats, 0, ux, uy, uz, ix, iy, iz,
+                           with_detailed_bottom) * t / (n_water * n_water)
                 for j in range(first, last):
                     deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
                             weight[j] * f * math.exp(tau[j] / iz))
@@ -491,7 +500,7 @@ def from_point(est, grid, surface, floats, ints, bp, tally, share, weight, tau, 
         t = surface_bsdf.transmittance(surface, mu_w)
         phi = 2.0 * math.pi * uniform(rng)
         f = toward(model, bp, floats, 0, ux, uy, uz, sin_w * math.cos(phi),
-                   sin_w * math.sin(phi), -mu_w)
+                   sin_w * math.sin(phi), -mu_w, with_detailed_bottom)
         for j in range(first, last):
             deposit(grid, tally, share, grid.cap + grid.n_depths * n, j,
                     weight[j] * f * math.exp(-tau[j] / mu_w) * t / (n_water * n_water))

@@ -101,19 +101,21 @@ def split(ctrl, grid, stack, stack_ps, n_stacked, p, ps):
 
 
 @internal
-def facet_walk(surface, floats, p, rng):
+def facet_walk(surface, floats, p, rng, with_facet_walk):
     """The rough surface in split()'s form: one sample of it (its table or its facet walk;
     weight f cos / pdf applied to p.w), as R = 1 into the reflected direction or R = 0 into the
     transmitted one, so that the delta surface's expected-value scoring applies to it
     unchanged."""
     ox, oy, oz, weight, transmitted = surface_bsdf.sample(surface, p.ux, p.uy, p.uz,
-                                                          uniform(rng), rng, floats)
+                                                          uniform(rng), rng, floats,
+                                                          with_facet_walk)
     p.w *= weight
     return (0.0 if transmitted else 1.0), ox, oy, oz, ox, oy, oz
 
 
 @internal
-def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_rough_surface):
+def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_rough_surface,
+                   with_facet_walk):
     """A packet from the air meets the surface: scored at 0+ (incoming, and the reflected part),
     and what enters the water is scored at 0-; returns whether anything enters. Linear in w: in
     implicit mode the whole solar beam of a batch enters a delta surface in one call."""
@@ -123,7 +125,7 @@ def enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_ro
     if with_rough_surface is None or surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, with_facet_walk)
         w = p.w
     if ctrl.analog:
         reflected = r > 0.0 and uniform(rng) < r
@@ -209,7 +211,7 @@ def free_flight(medium, ctrl, grid, floats, ints, tally, ps, p, tau, rng, with_s
 @internal
 def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, stack, stack_ps,
             n_stacked, p, layer, events, rng, rng_emitted, with_spectral, with_inelastic,
-            with_rough_surface, with_local_estimates):
+            with_rough_surface, with_facet_walk, with_local_estimates, with_exact_directions):
     """A collision in `layer`: local estimates, the inelastic channels' emissions (kernel/
     channels/: they take their share of every wavelength and emit it, light the packet carries
     on or that waits on the stack in packets of its own), absorption (implicit: weight times
@@ -241,11 +243,13 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
         local_estimate.collision_depths(medium, floats, grid, work, p, layer)
     if with_local_estimates is not None and estimates:
         local_estimate.at_collision(est, grid, medium, surface, floats, ints, tally, ps, work,
-                                    p, layer, p.w * albedo, rng, with_rough_surface)
+                                    p, layer, p.w * albedo, rng, with_rough_surface,
+                                    with_facet_walk, with_exact_directions)
     if with_inelastic is not None:
         n_stacked = channels.emit(medium, surface, ctrl, grid, est, floats, ints, tally, work,
                                   stack, stack_ps, n_stacked, p, ps, layer, carrying,
-                                  rng_emitted, with_rough_surface, with_local_estimates)
+                                  rng_emitted, with_rough_surface, with_facet_walk,
+                                  with_local_estimates, with_exact_directions)
     w = p.w
     budget = grid.budget
     if ctrl.analog:
@@ -288,7 +292,7 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
 
 @internal
 def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_spectral,
-                     with_rough_surface):
+                     with_rough_surface, with_facet_walk):
     """A packet meets the surface from below: what leaves is scored at 0+ (all light and
     water-leaving light) and in the budget; what is reflected goes on (implicit: by roulette
     with probability R, carrying w, so a weak internally reflected packet costs no more than in
@@ -297,7 +301,7 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_
     if with_rough_surface is None or surface.delta:
         r, rx, ry, rz, tx, ty, tz = surface_bsdf.split(surface, p.ux, p.uy, p.uz)
     else:
-        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng)
+        r, rx, ry, rz, tx, ty, tz = facet_walk(surface, floats, p, rng, with_facet_walk)
     w = p.w
     if ctrl.analog:
         goes_on = r > 0.0 and uniform(rng) < r
@@ -323,8 +327,9 @@ def leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p, rng, with_
 
 @internal
 def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp, tally, ps,
-                      work, p, rng, with_spectral, with_rough_surface, with_reflecting_bottom,
-                      with_local_estimates):
+                      work, p, rng, with_spectral, with_rough_surface, with_facet_walk,
+                      with_reflecting_bottom, with_detailed_bottom, with_local_estimates,
+                      with_exact_directions):
     """A packet meets the bottom: local estimates of what it reflects, a reflected direction
     sampled from the BRDF with weight rho_dh (f cos / pdf), absorption of the rest. Returns
     whether the packet goes on."""
@@ -335,10 +340,12 @@ def reflect_at_bottom(medium, surface, bottom, ctrl, grid, est, floats, ints, bp
         return False
     if with_local_estimates is not None and (est.directions_on or est.cap_on):
         local_estimate.at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally,
-                                 ps, work, p, rng, with_rough_surface)
+                                 ps, work, p, rng, with_rough_surface, with_facet_walk,
+                                 with_detailed_bottom, with_exact_directions)
     u1 = uniform(rng)
     u2 = uniform(rng)
-    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2)
+    ux, uy, uz, rho = brdf.reflect(bottom.model, bp, p.ux, p.uy, p.uz, u1, u2,
+                                   with_detailed_bottom)
     p.ux = ux
     p.uy = uy
     p.uz = uz
@@ -393,8 +400,9 @@ def after_reflection(medium, ctrl, grid, floats, ints, tally, ps, stack, stack_p
 
 @batch
 def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row, ctrl_row,
-                floats, ints, with_spectral, with_inelastic, with_rough_surface,
-                with_reflecting_bottom, with_local_estimates, n_photons, start, work_budget,
+                floats, ints, with_spectral, with_inelastic, with_rough_surface, with_facet_walk,
+                with_reflecting_bottom, with_detailed_bottom, with_local_estimates,
+                with_exact_directions, n_photons, start, work_budget,
                 rng, rng_emitted, beam_in, tally_row, packet_row, stack, states, work):
     """Photons start, start + 1, ... of one batch of n_photons packets whose weights add up to
     n_photons, until the batch ends or, at a photon boundary, work_budget is spent (one unit
@@ -462,7 +470,7 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
         if with_spectral is not None and grid.n_wl > 1:
             spectral.start(medium, grid, floats, ps, p, from_sky, rng)
         if from_air and not enter_from_air(surface, ctrl, grid, floats, ints, tally, ps, p, rng,
-                                           with_rough_surface):
+                                           with_rough_surface, with_facet_walk):
             continue
         if i < 0:
             w_sun_in, sx, sy, sz = p.w / n_sun, p.ux, p.uy, p.uz
@@ -489,18 +497,21 @@ def trace_batch(medium_row, surface_row, bottom_row, sky_row, grid_row, est_row,
                                                     stack_ps, n_stacked, p, where, walk_events,
                                                     draws, rng_emitted, with_spectral,
                                                     with_inelastic, with_rough_surface,
-                                                    with_local_estimates)
+                                                    with_facet_walk, with_local_estimates,
+                                                    with_exact_directions)
                 elif outcome == FLIGHT_PLANE:
                     plane, level = cross_plane(medium, grid, floats, ints, tally, ps, p, where)
                     if plane == PLANE_SURFACE:
                         alive = leave_or_reflect(surface, ctrl, grid, floats, ints, tally, ps, p,
-                                                 draws, with_spectral, with_rough_surface)
+                                                 draws, with_spectral, with_rough_surface,
+                                                 with_facet_walk)
                     elif plane == PLANE_BOTTOM:
                         alive = reflect_at_bottom(medium, surface, bottom, ctrl, grid, est,
                                                   floats, ints, bp, tally, ps, work, p, draws,
                                                   with_spectral, with_rough_surface,
-                                                  with_reflecting_bottom,
-                                                  with_local_estimates)
+                                                  with_facet_walk, with_reflecting_bottom,
+                                                  with_detailed_bottom, with_local_estimates,
+                                                  with_exact_directions)
                     elif ctrl.depth_windows:
                         n_stacked = split_into(grid, stack, stack_ps, n_stacked, p, ps,
                                                weight_window.copies(ctrl_row[p.seg], grid, p,

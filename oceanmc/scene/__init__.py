@@ -9,9 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import config as cfg
-from .. import optics
+from .. import optics, registry
+from ..kernel import models
 from ..kernel.records import ESTIMATOR, SPLIT_STACK_ROWS, merge, record
-from ..kernel.variants import Variant
+from ..kernel.variants import CLOSED_FORM_BOTTOMS, Variant
 from . import bottom, estimates, grid, medium, sky, surface, weight_window
 from .grid import Grid, make_grid  # noqa: F401  (the run and the tests use them from here)
 
@@ -62,14 +63,21 @@ class Scene:
     def variant(self) -> Variant:
         """The optional parts of the photon loop that this scene's records may run
         (kernel/variants.py): trace it only on a variant that holds them."""
-        g, est = self.grid[0], self.estimates[0]
+        g, est, bottom = self.grid[0], self.estimates[0], self.bottom[0]
         inelastic = bool(self.medium[0]["n_channels"] > 1 or g["n_parts"] > 1)
+        rough = not self.surface[0]["delta"]
+        reflects = bool(bottom["reflects"])
         # (the kernel settles inelastic light through the spectral walk's functions: a scene
         # with inelastic light uses both parts, whatever its number of wavelengths)
         return Variant(spectral=bool(g["n_wl"] > 1) or inelastic, inelastic=inelastic,
-                       rough_surface=not self.surface[0]["delta"],
-                       reflecting_bottom=bool(self.bottom[0]["reflects"]),
-                       local_estimates=bool(est["directions_on"] or est["cap_on"]))
+                       rough_surface=rough,
+                       facet_walk=rough and not self.surface[0]["tabulated"],
+                       reflecting_bottom=reflects,
+                       detailed_bottom=reflects and (
+                           int(bottom["model"]) not in CLOSED_FORM_BOTTOMS
+                           or bool(self.floats[bottom["params"] + models.BRDF_SAMPLER] > 0.0)),
+                       local_estimates=bool(est["directions_on"] or est["cap_on"]),
+                       exact_directions=bool(est["directions_on"]))
 
 
 def predicted_variant(config: cfg.SceneConfig) -> Variant:
@@ -79,11 +87,21 @@ def predicted_variant(config: cfg.SceneConfig) -> Variant:
     second compilation, never a wrong result."""
     asked = config.water.inelastic
     inelastic = asked is not None and bool(asked.processes())
+    sea = surface.pack(config.surface, config.n_water)[0]
+    bottom = config.bottom
+    # (a mixture is packed as the Lambertian or Minnaert bottom of its shape: optics/bottom.py)
+    shape = bottom.components[0].model if bottom.model == "mixture" else bottom.model
+    reflects = shape not in ("none", "black")
     return Variant(spectral=len(config.wavelengths) > 1 or inelastic, inelastic=inelastic,
-                   rough_surface=not surface.pack(config.surface, config.n_water)[0]["delta"],
-                   reflecting_bottom=config.bottom.model not in ("none", "black"),
+                   rough_surface=not sea["delta"],
+                   facet_walk=not sea["delta"] and not sea["tabulated"],
+                   reflecting_bottom=reflects,
+                   detailed_bottom=reflects and (
+                       registry.bottom_id(shape) not in CLOSED_FORM_BOTTOMS
+                       or getattr(bottom, "sampling", "auto") == "tabulated"),
                    local_estimates=bool(config.tallies.local_directions_deg)
-                   or config.nadir_local)
+                   or config.nadir_local,
+                   exact_directions=bool(config.tallies.local_directions_deg))
 
 
 def pack_estimator(est: cfg.Estimator, column: medium.Column) -> np.ndarray:

@@ -17,9 +17,11 @@ def tabulated_sampler(params):
 
 
 @kernel
-def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
+def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz, with_detailed_bottom=True):
     """f(wi, wo) in 1/sr; for models with a mirror component only the finite part (local
-    estimates miss the mirror: config/scene.py refuses them for such bottoms)."""
+    estimates miss the mirror: config/scene.py refuses them for such bottoms).
+    with_detailed_bottom None: the closed-form four only (kernel/variants.py; the photon loop
+    passes its own, True elsewhere)."""
     if model == BOTTOM_LAMBERTIAN:
         return lambertian.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_MINNAERT:
@@ -28,6 +30,8 @@ def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
         return specular.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_LAMBERTIAN_SPECULAR:
         return lambertian_specular.evaluate(params, wix, wiy, wiz, wox, woy, woz)
+    if with_detailed_bottom is None:
+        return 0.0
     if model == BOTTOM_GGX:
         return ggx.evaluate(params, wix, wiy, wiz, wox, woy, woz)
     if model == BOTTOM_HAPKE:
@@ -38,9 +42,10 @@ def evaluate_local(model, params, wix, wiy, wiz, wox, woy, woz):
 
 
 @kernel
-def sample_local(model, params, wix, wiy, wiz, u1, u2):
-    """(wox, woy, woz, weight) with weight = f cos(theta_o) / pdf."""
-    if tabulated_sampler(params):
+def sample_local(model, params, wix, wiy, wiz, u1, u2, with_detailed_bottom=True):
+    """(wox, woy, woz, weight) with weight = f cos(theta_o) / pdf (with_detailed_bottom as
+    evaluate_local's)."""
+    if with_detailed_bottom is not None and tabulated_sampler(params):
         wox, woy, woz, dens = general.sample(params, wix, wiy, wiz, u1, u2)
         if dens <= 0.0:
             return wox, woy, woz, 0.0
@@ -53,7 +58,7 @@ def sample_local(model, params, wix, wiy, wiz, u1, u2):
         return specular.sample(params, wix, wiy, wiz, u1, u2)
     if model == BOTTOM_LAMBERTIAN_SPECULAR:
         return lambertian_specular.sample(params, wix, wiy, wiz, u1, u2)
-    if model == BOTTOM_GGX:
+    if with_detailed_bottom is not None and model == BOTTOM_GGX:
         return ggx.sample(params, wix, wiy, wiz, u1, u2)
     return 0.0, 0.0, 1.0, 0.0  # black (Hapke and tables always use the tabulated sampler)
 
@@ -87,9 +92,11 @@ def sampled_mirror(model, params, u1):
 
 
 @kernel
-def reflect(model, params, ux, uy, uz, u1, u2):
+def reflect(model, params, ux, uy, uz, u1, u2, with_detailed_bottom=True):
     """A photon travelling (ux, uy, uz), uz > 0, meets the bottom: returns the reflected travel
     direction (upward) and the weight factor. Local frame = (x, -y, -z) of the global one (a
-    rotation by pi about x, so handedness is kept); wi is minus the local travel direction."""
-    wox, woy, woz, weight = sample_local(model, params, -ux, uy, uz, u1, u2)
+    rotation by pi about x, so handedness is kept); wi is minus the local travel direction.
+    (with_detailed_bottom as evaluate_local's.)"""
+    wox, woy, woz, weight = sample_local(model, params, -ux, uy, uz, u1, u2,
+                                         with_detailed_bottom)
     return wox, -woy, -woz, weight

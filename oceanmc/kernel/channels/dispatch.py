@@ -16,8 +16,8 @@ def scatter(medium, floats, ints, ctrl, grid, tally, ps, work, p, layer, carryin
 
 @internal
 def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack, stack_ps,
-         n_stacked, p, ps, layer, carrying, rng_emitted, with_rough_surface,
-         with_local_estimates):
+         n_stacked, p, ps, layer, carrying, rng_emitted, with_rough_surface, with_facet_walk,
+         with_local_estimates, with_exact_directions):
     """Every inelastic channel (1 .. n_channels - 1; their models: MEDIUM channel_model, all
     run by channels/inelastic.py) of a collision of packet p, before its implicit capture;
     work[:n_wl] holds the collision's weight per unit coefficient at every wavelength
@@ -30,7 +30,8 @@ def emit(medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
         n_stacked = inelastic.emit(channel, medium, surface, ctrl, grid, est, floats, ints,
                                    tally_row, work, stack, stack_ps, n_stacked, p, ps, layer,
                                    carrying, rng_emitted, with_rough_surface,
-                                   with_local_estimates)
+                                   with_facet_walk, with_local_estimates,
+                                   with_exact_directions)
     return n_stacked
 
 

@@ -57,7 +57,7 @@ from ..tally import move_all, spectral_at
 @internal
 def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, work, stack,
          stack_ps, n_stacked, p, ps, layer, carrying, rng_emitted, with_rough_surface,
-         with_local_estimates):
+         with_facet_walk, with_local_estimates, with_exact_directions):
     """Channel `channel` (1 ..) of a collision of packet p in `layer`, whose weights per unit
     coefficient are work[:n] (spectral.collision_density; book_takes has booked what it takes
     from each wavelength): scores the local estimates of the emission
@@ -141,7 +141,7 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
                                    tally_row[child_part:child_part + part_size], work, p, layer,
                                    medium.channel_beta + channel, est.emission_tables + k,
                                    first_emitted, after_emitted, rng_emitted,
-                                   with_rough_surface)
+                                   with_rough_surface, with_facet_walk, with_exact_directions)
     if not spawn:
         return n_stacked
     shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)

@@ -28,18 +28,22 @@ def split(surface, ux, uy, uz):
 
 
 @kernel
-def sample(surface, ux, uy, uz, u, rng, floats=None):
+def sample(surface, ux, uy, uz, u, rng, floats=None, with_facet_walk=True):
     """(ox, oy, oz, weight, transmitted): the direction the photon leaves in and the weight
     f cos / pdf, 1 for every model. u is the first uniform draw (a delta surface reflects when
     u < R), rng the stream for any further ones (the rough surface's). floats: the scene's
     float pool, which holds a tabulated rough surface's table; without it (None: Numba
-    compiles that call without the table's branch) the rough surface walks."""
+    compiles that call without the table's branch) the rough surface walks.
+    with_facet_walk None: a photon loop without the facet walk (kernel/variants.py), whose
+    scenes' rough surfaces are all tabulated (weight 0 for any other)."""
     if surface.model == SURFACE_COX_MUNK:
         if floats is not None:
             if surface.tabulated:
                 ox, oy, oz, transmitted = cox_munk_table.sample(surface, floats, ux, uy, uz,
                                                                 u, rng)
                 return ox, oy, oz, 1.0, transmitted
+        if with_facet_walk is None:
+            return ux, uy, uz, 0.0, False
         ox, oy, oz, transmitted = cox_munk.walk(surface, ux, uy, uz, u, rng)
         return ox, oy, oz, 1.0, transmitted
     r, rx, ry, rz, tx, ty, tz = split(surface, ux, uy, uz)
