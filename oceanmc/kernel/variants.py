@@ -14,7 +14,7 @@ Why: one trace_batch holding every part took 64-73 s to compile on a cold start 
 cores, 2026-11-27; trace_batch's own LLVM work alone 34 s), most of it for parts that a given
 scene never runs; run/compiling.py has the figures per variant. The rough sea's facet walk,
 the bottoms beyond the closed-form four and the exact directions' local estimates became parts
-of their own on 2026-11-29: leaving them out took 1.3-4 s off cold starts of the shipped
+of their own on 2026-11-28: leaving them out took 1-5 s off cold starts of the shipped
 configs that do not use them (benchmarks/speed.md; run/compiling.py)."""
 from __future__ import annotations
 

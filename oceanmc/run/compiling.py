@@ -99,6 +99,17 @@ cache, one run each, the plain variant 15.6 s against 20.7 s, the whole loop 78.
 bare_walk.yaml 19.4 / 15.2 s against 26.4 / 23.7 s, default.yaml 39.5 / 37.7 s against
 49.7 / 49.9 s, windy_case1.yaml 44.4 s against 61.5 s, raman_fluorescence.yaml 62.7 s against
 85.9 s. What is left is mostly trace_batch's own compilation, which no second process shares.
+Parts of their own for the rough sea's facet walk (three inlined call sites, where a tabulated
+sea needs none), the bottoms beyond the closed-form four (GGX, Hapke, tables and the general
+tabulated sampler: the BRDF dispatch at the bottom event, in its local estimates and, until
+then, in an emission's exact directions, which never reach a BRDF) and the exact directions'
+local estimates (kernel/variants.py REFINES; 2026-11-28, kernel 98f0a19 against the change,
+cold `oceanmc run CONFIG --photons 20000`, empty caches, interleaved, twice, a busy day of this
+machine): default.yaml 12.7 / 16.6 s against 11.7 / 11.7 s, shallow_sand_spectral.yaml 20.2 /
+18.7 s against 17.6 / 16.1 s, windy_case1.yaml 20.6 / 18.7 s against 19.2 / 17.3 s,
+raman_fluorescence.yaml 21.4 / 22.9 s against 20.0 / 19.0 s; deep_chlorophyll_maximum.yaml,
+which uses none of them, 14.6 / 15.6 s against 14.7 / 16.4 s (every output the same bit for
+bit).
 """
 from __future__ import annotations
 
