@@ -273,16 +273,23 @@ def child_main(variant: str, scene_files: list[str]) -> None:
     """The compiling child process: compiles the part `events` of the variant (its parts as
     0s and 1s in PARTS' order) into the shared cache, says so on stdout, then packs the scenes
     of scene_files while the parent compiles trace_batch (their tables, cached on disk, are
-    then the parent's for the asking: a profile's or a windy sea's take seconds to build). A
-    scene it cannot pack is left to the parent, which reports why."""
+    then the parent's for the asking: a profile's or a windy sea's take seconds to build), and
+    compiles what their runs call after the photons. A scene it cannot pack is left to the
+    parent, which reports why."""
     compile_part("events", Variant(*(flag == "1" for flag in variant)))
     print(EVENTS_COMPILED, flush=True)
     os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no one reads on
     from ..config import load_config
+    from ..scene.surface import reflected_local
     from .simulation import prepare
     for path in scene_files:
         try:
-            prepare(load_config(path))
+            run = prepare(load_config(path))
+            if run.config.tallies.local_directions_deg:
+                # what the run calls after its photons, compiled into the disk cache here: the
+                # exact directions' reflected sky and sun glint (surface.dispatch.reflected_from,
+                # cox_munk.glint_single; 1.5 s of a cold windy_case1.yaml in the parent)
+                reflected_local(run.config, run.scene.surface[0], 0, 1)
         except Exception:  # the parent packs it again and says what is wrong
             pass
 
