@@ -90,13 +90,13 @@ def attenuation_depths(layers: list[optics.LayerIOPs], z: np.ndarray) -> np.ndar
     """zeta at depths z (m) at the least attenuated wavelength: min over wavelengths of the
     integral of K (above) from the surface."""
     z = np.atleast_1d(np.asarray(z, dtype=np.float64))
-    zeta = np.zeros((len(layers[0].a), len(z)))
-    for layer in layers:
-        inside = np.clip(z - layer.top_m, 0.0, layer.thickness_m)
-        attenuation = np.minimum((layer.a + layer.bb) / MEAN_COSINE,
-                                 np.sqrt(3.0 * layer.a * (layer.a + layer.bb)))
-        zeta += np.outer(attenuation, inside)
-    return zeta.min(axis=0)
+    a = np.array([layer.a for layer in layers])
+    bb = np.array([layer.bb for layer in layers])
+    attenuation = np.minimum((a + bb) / MEAN_COSINE, np.sqrt(3.0 * a * (a + bb)))
+    inside = np.clip(z - np.array([[layer.top_m] for layer in layers]), 0.0,
+                     np.array([[layer.thickness_m] for layer in layers]))
+    # (layers, wavelengths, depths), summed over the layers in their order, as a loop would
+    return np.sum(attenuation[:, :, None] * inside[:, None, :], axis=0).min(axis=0)
 
 
 def choose(config: cfg.SceneConfig, layers: list[optics.LayerIOPs]) -> DepthWindows:
