@@ -373,14 +373,17 @@ def ready(variant: Variant = EVERYTHING, should_stop: Callable[[], bool] | None 
         worker.start()
         said = 0.0
         try:
-            while worker.is_alive():
+            while True:
                 worker.join(0.1)
+                # asked at least once, even when the worker is done before the first look (a
+                # load from the cache may be: a stop asked meanwhile was missed, 2026-11-29)
                 if should_stop is not None and should_stop():
                     raise CompileInterrupted("while compiling the photon loop" if cold else
                                              "while loading the photon loop from the disk cache")
+                if not worker.is_alive():
+                    break
                 elapsed = time.perf_counter() - t0
-                if worker.is_alive() and elapsed >= COMPILE_NOTICE_AFTER_S \
-                        and elapsed - said >= 5.0:
+                if elapsed >= COMPILE_NOTICE_AFTER_S and elapsed - said >= 5.0:
                     if not said:
                         print(f"oceanmc: compiling the photon loop with its parts for this "
                               f"scene ({held.label}; once per oceanmc version and set of parts "
