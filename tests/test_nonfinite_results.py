@@ -27,12 +27,14 @@ def poison(monkeypatch, value=math.nan, wavelength=None, when=lambda batches: Tr
     Eod and Eo = Eod + Eou) of
     the given wavelength (index; None: every one), when `when(whole batches)` holds."""
     real = derivation.from_tallies
+    seen = {"k": -1}
 
     def from_tallies(raw, *args, **kwargs):
-        raw = dict(raw, flux=raw["flux"].copy())   # (batch, wavelength, level, 4)
-        if raw["flux"].shape[0] and when(raw["flux"].shape[0]):
-            raw["flux"][0, slice(None) if wavelength is None else wavelength, 0,
-                        FLUX_EOD] = value
+        seen["k"] += 1
+        raw = dict(raw, flux=raw["flux"].copy())
+        if raw["flux"].shape[0] and when(raw["flux"].shape[0]) and \
+                wavelength in (None, seen["k"] % len(SPECTRAL["wavelengths_nm"])):
+            raw["flux"][0, 0, FLUX_EOD] = value
         return real(raw, *args, **kwargs)
     monkeypatch.setattr(derivation, "from_tallies", from_tallies)
 

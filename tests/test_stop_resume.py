@@ -15,7 +15,7 @@ import oceanmc
 from oceanmc.run import simulation
 from oceanmc.run.hdf5 import load_result
 from oceanmc.run.results import MergeError, merge_results
-from oceanmc.scene.grid import tally_arrays, write_tally_arrays
+from oceanmc.scene.grid import tally_arrays, tally_views, write_tally_arrays
 
 from conftest import REPO
 from test_robustness import ENV
@@ -149,7 +149,7 @@ def test_a_huge_run_stops_within_seconds(tmp_path, signal_number):
 def test_tally_arrays_round_trip_exactly():
     """A spectral scene's tally rows as named arrays (wavelength last) and back, bit for bit:
     views -> rows -> views, and rows -> views -> rows on every score; the arrays are disjoint
-    (random values survive the round trip)."""
+    (random values survive the round trip) and tally_views is their slice at one wavelength."""
     config = oceanmc.load_config({
         "name": "tally arrays", "wavelengths_nm": [450.0, 550.0, 650.0],
         "water": {"layers": [{"thickness_m": 5.0, "a": 0.1, "b": 0.4},
@@ -175,6 +175,9 @@ def test_tally_arrays_round_trip_exactly():
     scores = ~np.isnan(rebuilt)   # every cell a score array wrote holds the row's value
     assert scores.sum() == sum(values.size for values in arrays.values())
     assert np.array_equal(rebuilt[scores], rows[scores])
+    for j in range(n_wl):
+        for name, values in tally_views(sc.grid, rows, j).items():
+            assert np.array_equal(values, arrays[name][..., j]), name
     with pytest.raises(ValueError, match="tally cap is"):
         write_tally_arrays(sc.grid, dict(arrays, cap=arrays["cap"][..., :2]), rebuilt)
 

@@ -1,15 +1,8 @@
 """Derivation: a run's tallies -> the quantities of its Result. The kernel's per-batch weight
-sums, per part of the light (scene/grid.py tally_arrays), are normalised per launched photon
-and Ed(0+) (radiances also per quad solid angle) into the contract's quantities, each part of
-the light beside the whole, every wavelength at once (a wavelength axis after the batch axis;
-one wavelength keeps the monochromatic layout, without it). (derived.py then computes the
-apparent optical properties from a Result.)
-
-Every wavelength in one pass, not one Result per wavelength stacked afterwards (until
-2026-11-28): the same arithmetic on every element, so the same values bit for bit
-(benchmarks/regression.md), in less time: the inelastic bench's run has 37 wavelengths and 4
-parts, 148 derivations and 128 stacked quantities before (benchmarks/inelastic.md times the
-whole simulate())."""
+sums, per wavelength and per part of the light (scene/grid.py tally_views), are normalised per
+launched photon and Ed(0+) (radiances also per quad solid angle) into the contract's quantities,
+each part of the light beside the whole, the wavelengths stacked. (derived.py then computes the
+apparent optical properties from a Result.)"""
 from __future__ import annotations
 
 import math
@@ -19,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..kernel import models
-from .result import Quantity, Result
+from .result import Quantity, Result, common_quantities
 
 if TYPE_CHECKING:   # the scene's packers (0.5 s to import) stay out of `oceanmc show`
     from ..config import SceneConfig
@@ -71,28 +64,32 @@ class RunFacts:
         return len(self.parts) > 1
 
 
-def run_result(tallies: dict[str, np.ndarray], done: int, facts: RunFacts, attrs: dict,
-               reflected: np.ndarray | None) -> Result:
-    """The Result of a run's leading `done` whole batches from its tally arrays (scene/grid.py
-    tally_arrays: batch axis first, wavelength axis last): the parts of the light (part<i>/,
-    the elastic light's unprefixed) and their sum, the whole, derived by from_tallies and, with
-    inelastic light, the parts added beside the whole (add_parts). reflected: (batches,
-    wavelengths, directions, 2), the surface-reflected radiances of the exact directions
-    (scene.surface.reflected_at at each wavelength), or None."""
-    parts = [{name.removeprefix(f"part{i}/"): np.moveaxis(values[:done], -1, 1)
-              for name, values in tallies.items()
-              if (name.startswith(f"part{i}/") if i else "/" not in name)}
-             for i in range(len(facts.parts))]
-    for part in parts:
-        part["budget"] = per_config_layer(part["budget"], facts.config_layer, facts.n_layers)
-    whole = {name: sum(part[name] for part in parts) for name in parts[0]}
-    if reflected is not None:
-        parts[0]["reflected_local"] = whole["reflected_local"] = reflected
-    result = from_tallies(whole, facts, attrs)
-    if facts.inelastic:
-        add_parts(result, {name: from_tallies(part, facts, attrs)
-                           for name, part in zip(facts.parts, parts)})
-    return result
+def run_result(views: list[dict[str, np.ndarray]], done: int, facts: RunFacts, attrs: dict,
+               reflected: list[np.ndarray] | None) -> Result:
+    """The Result of a run's leading `done` whole batches from its tally views (one per
+    wavelength): each wavelength's parts of the light (part<i>/ in the view, the elastic
+    light's unprefixed) and their sum, the whole, derived by from_tallies and, with inelastic
+    light, the parts added beside the whole (add_parts); one wavelength keeps the
+    monochromatic layout (no wavelength dimension). reflected: per wavelength, the
+    surface-reflected radiances of the exact directions (scene.surface.reflected_at), or None."""
+    per_wavelength = []
+    for k, view in enumerate(views):
+        parts = [{name.removeprefix(f"part{i}/"): values[:done]
+                  for name, values in view.items()
+                  if (name.startswith(f"part{i}/") if i else "/" not in name)}
+                 for i in range(len(facts.parts))]
+        for part in parts:
+            part["budget"] = per_config_layer(part["budget"], facts.config_layer, facts.n_layers)
+        whole = {name: sum(part[name] for part in parts) for name in parts[0]}
+        if reflected is not None:
+            parts[0]["reflected_local"] = whole["reflected_local"] = reflected[k]
+        result = from_tallies(whole, facts, k, attrs)
+        if facts.inelastic:
+            add_parts(result, {name: from_tallies(part, facts, k, attrs)
+                               for name, part in zip(facts.parts, parts)})
+        per_wavelength.append(result)
+    return per_wavelength[0] if len(views) == 1 else \
+        stack_wavelengths(per_wavelength, facts.wavelengths)
 
 
 def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int) -> np.ndarray:
@@ -139,27 +136,12 @@ def budget_terms(n_layers: int, inelastic: bool = False) -> list[tuple[int, str,
 
 
 class Quantities(dict):
-    """The quantities of a Result as from_tallies derives them, by name, in the order added,
-    from values (batch, wavelength, *dims): with one wavelength in the monochromatic layout
-    (batch, *dims), else with the dimension `wavelength` before dims."""
-
-    def __init__(self, spectral: bool):
-        super().__init__()
-        self.spectral = spectral
+    """The quantities of a Result as from_tallies derives them, by name, in the order added."""
 
     def add(self, name: str, dims: tuple[str, ...], values: np.ndarray, units: str,
             description: str) -> None:
-        if self.spectral:
-            dims = ("wavelength",) + dims
-        else:
-            values = values[:, 0]
         self[name] = Quantity(name, dims, np.ascontiguousarray(values, dtype=np.float64), units,
                               description)
-
-
-def _per_wavelength(values: np.ndarray, ndim: int) -> np.ndarray:
-    """(n_wl,) values shaped to multiply arrays (batch, wavelength, ...) of ndim axes."""
-    return values.reshape((-1,) + (1,) * (ndim - 2))
 
 
 LU_CROSSING = "polar-cap quad average (theta 175-180 deg with HydroLight edges), crossing " \
@@ -169,26 +151,27 @@ LU_LOCAL = "polar-cap quad average (theta 175-180 deg with HydroLight edges), lo
            "Lu_crossing, air/Lw_nadir_crossing, air/Rrs_nadir_crossing"
 
 
-def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, attrs: dict) -> Result:
-    """Normalises the raw per-batch weight sums (batch, wavelength, ...) (per launched photon,
-    times each wavelength's Ed(0+); radiances also per quad solid angle) and derives the
-    contract's quantities:
+def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
+                 attrs: dict) -> Result:
+    """Normalises the raw per-batch weight sums of wavelength index `wavelength` (per launched
+    photon, times its Ed(0+); radiances also per quad solid angle) and derives the contract's
+    quantities:
     the irradiances, the radiances on the quads (facts.radiance), Lu, Lw_nadir and Rrs_nadir
     from the local polar-cap estimate in raw["cap"] (facts.nadir_local), the exact directions'
     local estimates in raw["local"] and their surface-reflected radiance in
     raw["reflected_local"], and the budget. attrs: the run's, with Lu_method added."""
-    ed0 = np.asarray(facts.ed0, dtype=np.float64)
+    ed0 = float(facts.ed0[wavelength])
     scale = ed0 / facts.photons_per_batch
-    q = Quantities(len(ed0) > 1)
+    q = Quantities()
     add_irradiances(q, raw["flux"], facts.depths, scale)
     if facts.radiance:
-        # the sun's direct Ed(0+) at each wavelength (a spectrum's own diffuse share)
-        direct = ed0 * (1.0 - np.asarray(facts.diffuse, dtype=np.float64))
+        # the sun's direct Ed(0+) at this wavelength (a spectrum's own diffuse share)
+        direct = ed0 * (1.0 - float(facts.diffuse[wavelength]))
         add_radiances(q, raw["radiance"], facts, scale, ed0, direct)
     if facts.nadir_local:
-        add_nadir_local(q, raw["cap"] * _per_wavelength(scale, 3), len(facts.depths), ed0)
+        add_nadir_local(q, raw["cap"] * scale, len(facts.depths), ed0)
     if len(facts.directions):
-        add_exact_directions(q, raw["local"] * _per_wavelength(scale, 4), facts, ed0)
+        add_exact_directions(q, raw["local"] * scale, facts, ed0)
     if "reflected_local" in raw:
         add_reflected_local(q, raw["reflected_local"])
     add_budget(q, raw["budget"] / facts.photons_per_batch, facts)
@@ -201,63 +184,59 @@ def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, attrs: dict) -> Re
         "direction_theta": np.array([d[0] for d in facts.directions], dtype=np.float64),
         "direction_phi": np.array([d[1] for d in facts.directions], dtype=np.float64),
     }
-    if q.spectral:
-        coords["wavelength"] = np.asarray(facts.wavelengths, dtype=np.float64)
     attrs = dict(attrs)
     attrs["Lu_method"] = LU_LOCAL if facts.nadir_local else LU_CROSSING
     return Result(coords, dict(q), attrs)
 
 
 def add_irradiances(q: Quantities, raw_flux: np.ndarray, depths: np.ndarray,
-                    scale: np.ndarray) -> None:
+                    scale: float) -> None:
     """The plane and scalar irradiances at the tally depths and at 0+ (all light, and the
-    water-leaving light alone), and the surface's upward transmittance t_up (left out where a
-    batch has no upwelling light at some wavelength: result.UNDEFINED_RATIOS)."""
+    water-leaving light alone), and the surface's upward transmittance t_up."""
     n_depths = len(depths)
-    flux = raw_flux[:, :, :n_depths] * _per_wavelength(scale, 4)
-    q.add("Ed", ("depth",), flux[..., models.FLUX_ED], IRR_UNITS, "downward plane irradiance")
-    q.add("Eu", ("depth",), flux[..., models.FLUX_EU], IRR_UNITS, "upward plane irradiance")
-    q.add("Eod", ("depth",), flux[..., models.FLUX_EOD], IRR_UNITS,
+    flux = raw_flux[:, :n_depths] * scale
+    q.add("Ed", ("depth",), flux[:, :, models.FLUX_ED], IRR_UNITS, "downward plane irradiance")
+    q.add("Eu", ("depth",), flux[:, :, models.FLUX_EU], IRR_UNITS, "upward plane irradiance")
+    q.add("Eod", ("depth",), flux[:, :, models.FLUX_EOD], IRR_UNITS,
           "downward scalar irradiance")
-    q.add("Eou", ("depth",), flux[..., models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance")
-    q.add("Eo", ("depth",), flux[..., models.FLUX_EOD] + flux[..., models.FLUX_EOU],
+    q.add("Eou", ("depth",), flux[:, :, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance")
+    q.add("Eo", ("depth",), flux[:, :, models.FLUX_EOD] + flux[:, :, models.FLUX_EOU],
           IRR_UNITS, "scalar irradiance Eod + Eou")
-    air = raw_flux[:, :, n_depths] * _per_wavelength(scale, 3)
-    leaving = raw_flux[:, :, n_depths + 1] * _per_wavelength(scale, 3)
-    q.add("air/Ed", (), air[..., models.FLUX_ED], IRR_UNITS,
+    air = raw_flux[:, n_depths] * scale
+    leaving = raw_flux[:, n_depths + 1] * scale
+    q.add("air/Ed", (), air[:, models.FLUX_ED], IRR_UNITS,
           "downward plane irradiance just above the surface (0+): sun and sky")
-    q.add("air/Eu", (), air[..., models.FLUX_EU], IRR_UNITS,
+    q.add("air/Eu", (), air[:, models.FLUX_EU], IRR_UNITS,
           "upward plane irradiance at 0+: surface-reflected plus water-leaving")
-    q.add("air/Eod", (), air[..., models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance at 0+")
-    q.add("air/Eou", (), air[..., models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
-    q.add("air/Eu_water_leaving", (), leaving[..., models.FLUX_EU], IRR_UNITS,
+    q.add("air/Eod", (), air[:, models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance at 0+")
+    q.add("air/Eou", (), air[:, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
+    q.add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
           "upward plane irradiance at 0+ from light transmitted out of the water only")
     at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
-    if len(at_surface) and np.all(flux[:, :, at_surface[0], models.FLUX_EU] > 0.0):
-        q.add("air/t_up", (), leaving[..., models.FLUX_EU]
-              / flux[:, :, at_surface[0], models.FLUX_EU],
+    if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
+        q.add("air/t_up", (), leaving[:, models.FLUX_EU] / flux[:, at_surface[0], models.FLUX_EU],
               "1", "upward transmittance of the surface for this run's upwelling light: "
               "Eu_water_leaving(0+) / Eu(0-) (absent when a batch, at any wavelength, has no "
               "upwelling light)")
 
 
-def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scale: np.ndarray,
-                  ed0: np.ndarray, direct: np.ndarray) -> None:
+def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scale: float,
+                  ed0: float, direct: float) -> None:
     """The radiance on the (theta, phi) quads at the tally depths and at 0+ (all light, the
     water-leaving light, the surface-reflected light and its reflectance factor rho, whose sky
-    radiance leaves out the sun's direct Ed(0+) `direct` at each wavelength), and the nadir
+    radiance leaves out the sun's direct Ed(0+) `direct` at this wavelength), and the nadir
     quantities from their polar cap (crossing estimates)."""
     grid, n_depths = facts.grid, len(facts.depths)
     omega = grid.solid_angle
-    rad = raw_radiance * _per_wavelength(scale, 5) / omega
+    rad = raw_radiance * scale / omega
     rad[..., grid.is_cap, :] = rad[..., grid.is_cap, :1]  # a cap's one value in every phi column
-    water_rad = rad[:, :, :n_depths]
-    air_rad = rad[:, :, n_depths]
-    lw = rad[:, :, n_depths + 1]
+    water_rad = rad[:, :n_depths]
+    air_rad = rad[:, n_depths]
+    lw = rad[:, n_depths + 1]
     q.add("radiance", ("depth", "theta", "phi"), water_rad, RAD_UNITS,
           "radiance on the (theta, phi) quads, quad average; theta from nadir of the direction "
           "of travel, phi from the sun's travel azimuth")
-    q.add("Lu", ("depth",), water_rad[..., -1, 0], RAD_UNITS,
+    q.add("Lu", ("depth",), water_rad[:, :, -1, 0], RAD_UNITS,
           "nadir-viewing radiance (upward travel), the polar-cap quad average")
     q.add("air/radiance", ("theta", "phi"), air_rad, RAD_UNITS,
           "radiance at 0+, all light: sun, sky, surface reflection, water-leaving")
@@ -272,32 +251,32 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
     # sky radiance, less the sun's collimated beam where it falls (Ed0 (1 - f) / (mu_s Omega))
     edges = grid.theta_edges
     if np.allclose(edges, 180.0 - edges[::-1]):
-        sky_down = air_rad[:, :, ::-1].copy()
+        sky_down = air_rad[:, ::-1].copy()
         theta_s = facts.sun_zenith_deg
         i = min(int(np.searchsorted(edges, theta_s, side="right")) - 1, len(edges) - 2)
         j = 0 if grid.is_cap[i] else int(np.searchsorted(grid.phi_edges, 0.0, "right")) - 1
         beam = direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
         mirror = len(edges) - 2 - i
-        sky_down[:, :, mirror, j] -= beam
+        sky_down[:, mirror, j] -= beam
         if grid.is_cap[i]:
-            sky_down[:, :, mirror, :] -= beam[:, None]
+            sky_down[:, mirror, :] -= beam
         # each batch's own ratio, so that batches stay independent and runs merge
-        lit = upward & (sky_down > 1e-12 * _per_wavelength(ed0, 4))
+        lit = upward & (sky_down > 1e-12 * ed0)
         rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)
         q.add("air/rho", ("theta", "phi"), rho, "1",
               "sea-surface reflectance factor L_reflected / L_sky per batch, L_sky the mean "
               "sky radiance (sun excluded) of the quad a flat surface reflects into this one; "
               "upward quads, 0 where a batch has no sky light there (a ratio of batch means: "
               "biased where few photons reach a quad; rho_local is exact)")
-    q.add("air/Lu", (), air_rad[..., -1, 0], RAD_UNITS,
+    q.add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
           "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
-    q.add("air/Lw_nadir", (), lw[..., -1, 0], RAD_UNITS,
+    q.add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
           "nadir water-leaving radiance at 0+, polar-cap quad average")
-    q.add("air/Rrs_nadir", (), lw[..., -1, 0] / ed0, "sr-1",
+    q.add("air/Rrs_nadir", (), lw[:, -1, 0] / ed0, "sr-1",
           "remote-sensing reflectance Lw_nadir / Ed(0+)")
 
 
-def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: np.ndarray) -> None:
+def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: float) -> None:
     """Lu, Lw_nadir and Rrs_nadir from the polar cap's local estimate (normalised `cap`); the
     crossing estimates of the quads, where tallied, stay beside them as *_crossing."""
     for name in ("Lu", "air/Lw_nadir", "air/Rrs_nadir"):
@@ -306,29 +285,27 @@ def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: np.ndarr
             crossing.name = name + "_crossing"
             crossing.description += " (crossing estimator)"
             q[crossing.name] = crossing
-    q.add("Lu", ("depth",), cap[:, :, :n_depths], RAD_UNITS,
+    q.add("Lu", ("depth",), cap[:, :n_depths], RAD_UNITS,
           "nadir-viewing radiance (upward travel), the polar-cap quad average, local estimate")
-    q.add("air/Lw_nadir", (), cap[:, :, n_depths], RAD_UNITS,
+    q.add("air/Lw_nadir", (), cap[:, n_depths], RAD_UNITS,
           "nadir water-leaving radiance at 0+, polar-cap quad average, local estimate")
-    q.add("air/Rrs_nadir", (), cap[:, :, n_depths] / ed0, "sr-1",
+    q.add("air/Rrs_nadir", (), cap[:, n_depths] / ed0, "sr-1",
           "remote-sensing reflectance Lw_nadir / Ed(0+)")
 
 
-def add_exact_directions(q: Quantities, local: np.ndarray, facts: RunFacts,
-                         ed0: np.ndarray) -> None:
+def add_exact_directions(q: Quantities, local: np.ndarray, facts: RunFacts, ed0: float) -> None:
     """The radiances of the exact directions of local_directions_deg (normalised `local`) at
     the tally depths and leaving the water, and their Rrs."""
     n_depths = len(facts.depths)
     water_rows = [w for w, _ in facts.local_rows]
     air_rows = [a for _, a in facts.local_rows]
-    q.add("local_radiance", ("depth", "direction"), local[:, :, :n_depths][..., water_rows],
+    q.add("local_radiance", ("depth", "direction"), local[:, :n_depths][:, :, water_rows],
           RAD_UNITS, "radiance in the exact directions of local_directions_deg (theta, phi "
           "of travel), local (next-event) estimate")
-    q.add("air/Lw_local", ("direction",), local[:, :, n_depths][..., air_rows], RAD_UNITS,
+    q.add("air/Lw_local", ("direction",), local[:, n_depths][:, air_rows], RAD_UNITS,
           "water-leaving radiance at 0+ in the exact directions of local_directions_deg, "
           "local (next-event) estimate")
-    q.add("air/Rrs_local", ("direction",),
-          local[:, :, n_depths][..., air_rows] / _per_wavelength(ed0, 3), "sr-1",
+    q.add("air/Rrs_local", ("direction",), local[:, n_depths][:, air_rows] / ed0, "sr-1",
           "Lw_local / Ed(0+)")
 
 
@@ -349,13 +326,13 @@ def add_budget(q: Quantities, budget: np.ndarray, facts: RunFacts) -> None:
     """The budget's terms (budget_terms; per launched photon in `budget`) and their total."""
     terms = budget_terms(facts.n_layers, facts.inelastic)
     for column, name, description in terms:
-        q.add(f"budget/{name}", (), budget[..., column], "1", description)
+        q.add(f"budget/{name}", (), budget[:, column], "1", description)
     # the kernel's columns for inelastic transfers (kernel/channels/) stay 0 without an
     # inelastic process, and are left out; what a process gives counts negative
     columns = sorted(column for column, _, _ in terms)
-    signed = budget[..., columns] * np.where(np.array(columns) == models.BUDGET_SHIFTED_IN,
-                                             -1.0, 1.0)
-    q.add("budget/total", (), signed.sum(axis=-1),
+    signed = budget[:, columns] * np.where(np.array(columns) == models.BUDGET_SHIFTED_IN,
+                                           -1.0, 1.0)
+    q.add("budget/total", (), signed.sum(axis=1),
           "1", "sum of all budget terms: 1 up to Russian-roulette noise (an inelastic "
           "process's part: 0)")
 
@@ -385,3 +362,20 @@ PART_DESCRIPTIONS = {
     "chlorophyll_fluorescence": "the light phytoplankton fluoresced",
     "cdom_fluorescence": "the light CDOM fluoresced",
 }
+
+
+def stack_wavelengths(parts: list[Result], wavelengths: np.ndarray) -> Result:
+    """One Result from the per-wavelength Results of a spectral run: every quantity gains a
+    leading `wavelength` dimension (nm; the coordinate `wavelength`), after the batch axis. A
+    ratio left out at some wavelength (UNDEFINED_RATIOS) is left out of the whole."""
+    first = parts[0]
+    kept = common_quantities(parts)
+    quantities = {
+        name: Quantity(name, ("wavelength",) + q.dims,
+                       np.stack([p.quantities[name].batches for p in parts], axis=1),
+                       q.units, q.description)
+        for name, q in first.quantities.items() if name in kept}
+    coords = dict(first.coords, wavelength=np.asarray(wavelengths, dtype=np.float64))
+    return Result(coords, quantities, dict(first.attrs))
+
+

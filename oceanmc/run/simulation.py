@@ -30,7 +30,7 @@ from ..optics import iops_table, illumination_spectrum
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..kernel.records import PACKET, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
-from ..scene.grid import tally_arrays, write_tally_arrays
+from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
 from .compiling import ready, startup_seconds
 from .derivation import RunFacts, run_result
 from .merge import MergeError
@@ -358,7 +358,7 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
     batches = Batches(run, first_batch)
     if resume_state is not None:
         batches.restore(resume_state)
-    tallies = tally_arrays(sc.grid, batches.tallies)
+    views = [tally_views(sc.grid, batches.tallies, j) for j in range(len(config.wavelengths))]
     args = sc.kernel_args() + variant.kernel_args()
 
     def result_of(wall: float) -> Result:
@@ -368,10 +368,10 @@ def simulate(config: PreparedRun | SceneConfig | dict[str, Any] | str | Path, *,
         attrs = run_attrs(run, batches, done, n_threads, wall, startup)
         unit = scene.surface.reflected_local(config, sc.surface[0], first_batch, done) \
             if config.tallies.local_directions_deg else None
-        reflected = None if unit is None else np.stack(
+        reflected = None if unit is None else \
             [scene.surface.reflected_at(unit, ed0, diffuse)
-             for ed0, diffuse in zip(run.facts.ed0, run.facts.diffuse)], axis=1)
-        result = run_result(tallies, done, run.facts, attrs, reflected)
+             for ed0, diffuse in zip(run.facts.ed0, run.facts.diffuse)]
+        result = run_result(views, done, run.facts, attrs, reflected)
         # before a checkpoint or the end hands it on to be written or returned
         check_finite(result, config.wavelengths)
         result.resume_state = state

@@ -196,3 +196,11 @@ def write_tally_arrays(grid_record: np.ndarray, arrays: dict[str, np.ndarray],
                              f"{view.shape} (batch, ..., wavelength)")
     for name, view in views.items():
         view[...] = arrays[name]
+
+
+def tally_views(grid_record: np.ndarray, tallies: np.ndarray,
+                wavelength: int = 0) -> dict[str, np.ndarray]:
+    """The named score arrays of tally_arrays at wavelength index `wavelength` (views into the
+    rows)."""
+    return {name: values[..., wavelength]
+            for name, values in tally_arrays(grid_record, tallies).items()}
