@@ -701,3 +701,15 @@ def test_grazing_collimated_sun_scalar_irradiance_is_exact():
     expected = 1.0 / math.cos(math.radians(89.9))
     assert r["air/Eod"] == pytest.approx(expected, rel=1e-9)
     assert r["Eod"][0] == pytest.approx(expected, rel=1e-9)
+
+
+def test_sea_surface_rho_with_the_sun_in_the_polar_cap_is_one_value_across_the_cap():
+    """air/rho with the sun at the zenith: its beam falls in the downward polar cap, the
+    mirror of the nadir-viewing cap, and is taken out of that cap's sky radiance once. A cap
+    is one quad, so rho is the same in each of its phi columns (the beam was subtracted twice
+    from column 0 until 2026-11-29, which left rho 0 there)."""
+    r = simulate(absorber_config(illumination={"Ed0": 1.0, "sun_zenith_deg": 0.0,
+                                               "diffuse_fraction": 0.5}))
+    rho = r["air/rho"]
+    cap = rho[-1]   # theta 175-180 deg: looking straight down at the sea
+    assert np.all(cap > 0.0) and np.all(cap == cap[0]), cap

@@ -257,9 +257,10 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
         j = 0 if grid.is_cap[i] else int(np.searchsorted(grid.phi_edges, 0.0, "right")) - 1
         beam = direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
         mirror = len(edges) - 2 - i
-        sky_down[:, mirror, j] -= beam
-        if grid.is_cap[i]:
+        if grid.is_cap[i]:   # a cap is one quad: its value in every phi column
             sky_down[:, mirror, :] -= beam
+        else:
+            sky_down[:, mirror, j] -= beam
         # each batch's own ratio, so that batches stay independent and runs merge
         lit = upward & (sky_down > 1e-12 * ed0)
         rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)
