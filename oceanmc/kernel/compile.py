@@ -47,6 +47,7 @@ import hashlib
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
 import llvmlite.binding as llvm
@@ -56,6 +57,7 @@ from numba.core.codegen import RuntimeLinker
 from numba.core.compiler import CompilerBase, DefaultPassBuilder
 from numba.core.compiler_lock import require_global_compiler_lock
 from numba.core.compiler_machinery import LoweringPass, register_pass
+from numba.core.config import _OptLevel
 from numba.core.typed_passes import AnnotateTypes
 
 
@@ -200,3 +202,65 @@ internal = _jit(_nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True, forc
 hot = _jit(_nrt=False, no_cfunc_wrapper=True, forceinline=True)
 batch = _jit(_nrt=False, nogil=True)
 setup = _jit()
+
+
+# How LLVM optimises the kernel's IR when run/compiling.py compiles a variant of the photon loop
+# (set here, among the kernel's sources, so that a change of them changes the kernel hash and
+# with it the disk cache). Level 1 (machine code is still generated at Numba's default level)
+# keeps the inlining of the event functions; measured on this 2-core machine, one process:
+# 14.7-15.7 s of compilation against 21.3 s at level 3, and as many photons/s on the bare-walk
+# scene (4.7M per CPU-second at both, within the noise).
+KERNEL_OPT_LEVEL = 1
+# LLVM's loop unrolling (its LoopUnrollPass and LoopFullUnrollPass; the loop vectoriser still
+# interleaves) off: the loops over wavelengths, levels and table rows have short trip counts
+# that the unrolled copies only lengthen. Measured 2026-11-29 (each variant compiled cold in a
+# process of its own, interleaved rounds; loop times medians of 5 runs): the inelastic bench's
+# scene 0.641 / 0.655 / 0.587 s against 0.704 / 0.794 / 0.695 s, its elastic scene, bare_walk,
+# default and windy_case1 as fast (within 1-4%, either way), and every variant compiled
+# 0.4-1.9 s sooner (LLVM's pass timings: loop unrolling was 9% of trace_batch's optimisation).
+KERNEL_LOOP_UNROLLING = False
+# Machine code without LLVM's loop strength reduction (its option --disable-lsr, read when
+# the code generator's passes are set up), 9% of the machine code's passes for trace_batch
+# (LLVM's pass timings; 0.86 s of 4.2 s for the inelastic variant): measured the same day,
+# with loop unrolling off in both, each variant compiled cold in a process of its own,
+# interleaved: compiled 0.0-1.6 s sooner (0.6 s on the mean of 10 pairs over four scenes), and
+# the photon loop as fast (loop times, medians of 5, four rounds: bare_walk, 10^6 photons on
+# one thread, 0.151 / 0.148 / 0.154 / 0.151 s against 0.150 / 0.148 / 0.150 / 0.150 s; the
+# inelastic bench's scene 0.613 / 0.674 / 0.660 / 0.604 s against 0.643 / 0.746 / 0.638 /
+# 0.636 s).
+KERNEL_LOOP_STRENGTH_REDUCTION = False
+
+
+def _kernel_pass_builder(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
+    """Numba 0.68's pass builder (numba/core/llvm_bindings.py create_pass_builder, which
+    numba.core.codegen calls for every function and module pass manager) with the kernel's
+    loop unrolling."""
+    options = llvm.create_pipeline_tuning_options()
+    options.speed_level = opt
+    options.slp_vectorization = slp_vectorize
+    options.loop_vectorization = loop_vectorize
+    options.loop_unrolling = KERNEL_LOOP_UNROLLING
+    return llvm.create_pass_builder(tm, options)
+
+
+@contextmanager
+def kernel_optimisation():
+    """Numba compiles with the kernel's LLVM settings (KERNEL_OPT_LEVEL, KERNEL_LOOP_UNROLLING,
+    KERNEL_LOOP_STRENGTH_REDUCTION) inside this block: run/compiling.py compiles the photon
+    loop's variants in it. (Numba builds its pass managers anew for every function, from its
+    config and its module's create_pass_builder, which this replaces while it lasts, and LLVM
+    reads its options when it sets up the code generator's passes; another Numba than 0.68
+    keeps its own pass builder.)"""
+    previous_level = numba.config.OPT
+    previous_builder = getattr(numba_codegen, "create_pass_builder", None)
+    numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
+    if LINK_ONLY and previous_builder is not None:
+        numba_codegen.create_pass_builder = _kernel_pass_builder
+    llvm.set_option("", f"--disable-lsr={str(not KERNEL_LOOP_STRENGTH_REDUCTION).lower()}")
+    try:
+        yield
+    finally:
+        numba.config.OPT = previous_level
+        if previous_builder is not None:
+            numba_codegen.create_pass_builder = previous_builder
+        llvm.set_option("", "--disable-lsr=false")   # (LLVM's default)

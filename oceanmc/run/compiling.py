@@ -125,21 +125,15 @@ from typing import Callable, Sequence
 
 import numba
 import numpy as np
-from numba.core.config import _OptLevel
 
 from ..kernel import records, sources, spectral, transport
-from ..kernel.compile import CACHE_DIR, CACHE_WRITABLE
+from ..kernel.compile import CACHE_DIR, CACHE_WRITABLE, kernel_optimisation
 from ..kernel.phase.dispatch import component_density
 from ..kernel.surface.dispatch import transmittance
 from ..kernel.transport import trace_batch
 from ..kernel.variants import EVERYTHING, PARTS, Variant
 
 COMPILE_NOTICE_AFTER_S = 1.0
-# LLVM's optimisation level for the kernel's IR (machine code is still generated at Numba's
-# default level): level 1 keeps the inlining of the event functions; measured on this 2-core
-# machine, one process: 14.7-15.7 s of compilation against 21.3 s at level 3, and as many
-# photons/s on the bare-walk scene (4.7M per CPU-second at both, within the noise)
-KERNEL_OPT_LEVEL = 1
 CHILD_TIMEOUT_S = 600.0
 
 
@@ -203,15 +197,11 @@ def parts(variant: Variant) -> dict[str, tuple[tuple, ...]]:
 
 
 def compile_part(name: str, variant: Variant) -> None:
-    """Compiles one part of a variant at the kernel's optimisation level (the child process
-    runs this)."""
-    previous = numba.config.OPT
-    numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
-    try:
+    """Compiles one part of a variant with the kernel's LLVM settings (kernel/compile.py
+    kernel_optimisation; the child process runs this too)."""
+    with kernel_optimisation():
         for dispatcher, sig in parts(variant)[name]:
             dispatcher.compile(sig)
-    finally:
-        numba.config.OPT = previous
 
 
 def _entry_signature(variant: Variant) -> tuple:
