@@ -67,7 +67,30 @@ wavelength; no change in interleaved runs), sums over wavelengths in four partia
 change by the cycle counters), carrying the emissions at only a quarter of the collisions (a
 timing ablation, weights not corrected: 4% less time, too little for the variance the carried
 light would gain). Switching the emissions off altogether (kernel 9b845d7, emit not called) left
-0.44 s of 0.72 s: the emissions were 39% of the inelastic photon loop."""
+0.44 s of 0.72 s: the emissions were 39% of the inelastic photon loop.
+
+Kernel 7b22a15 (2026-11-29, session 25): LLVM's loop unrolling and loop strength reduction
+off for the photon loop (kernel/compile.py kernel_optimisation): this section's inelastic
+photon loop 12% faster (10^5 photons, 2 threads, three interleaved rounds of 3 runs: 0.93-1.00
+s against 1.05-1.18 s; the whole simulate() 1.13-1.32 s against 1.26-1.53 s), the elastic one
+as fast, the same outputs bit for bit. The section itself, run for both kernels in turn, twice
+(a noisy hour of this machine: each run's simulate() moved 10-20%): inelastic 84,989 / 72,674
+photons/s against 65,471 / 72,242, the Raman part of Rrs(550) to 1% 3.6x / 3.9x the elastic
+run's against 4.2x / 3.9x. By cycle counters (as above, this section's scene, 10^5 photons,
+kernel 0eef064): an inelastic collision 5,000 cycles (the emissions 1,900: the transfers with
+what each takes 750, their cap scores 680; the booking of the takes 300; the collision's own
+local estimates 910; carrying the emissions on 800; the scattering 740; the collision's
+weights and optical depths 440), an elastic one 1,830 on its own variant (local estimates 660,
+scattering 450, weights and depths 370); the same elastic scene on the inelastic variant, its
+branches not taken, 2,480. Tried and not kept the same day: each part's scores, moves and
+shares limited to the wavelengths its light can reach (fluorescence's part 8 of 37, Raman's 33;
+a scratch copy with this scene's bands written in): 5,432 / 5,909 cycles per collision against
+5,000 / 5,466 for the kernel as it is (two interleaved pairs): the loops over a part's band,
+which start and end anywhere, do not vectorise as the whole rows do. With the emissions at
+1,900 cycles, the collision's own 3-part local estimates at 910 and the carry at 800, the 2x
+target needs an inelastic collision at about 3,100 cycles against an elastic one's 1,830 (at
+equal collisions per photon, 1.17 million per 10^5 photons in both, and the Raman part's 1.16
+times the elastic run's variance per photon): no part of it alone gives that."""
 from __future__ import annotations
 
 import time

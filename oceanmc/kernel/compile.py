@@ -218,6 +218,12 @@ KERNEL_OPT_LEVEL = 1
 # scene 0.641 / 0.655 / 0.587 s against 0.704 / 0.794 / 0.695 s, its elastic scene, bare_walk,
 # default and windy_case1 as fast (within 1-4%, either way), and every variant compiled
 # 0.4-1.9 s sooner (LLVM's pass timings: loop unrolling was 9% of trace_batch's optimisation).
+# With the next setting as well, against neither (kernel 7b22a15 against 0eef064, same day):
+# cold `oceanmc run CONFIG --photons 20000`, empty caches, interleaved, twice:
+# raman_fluorescence.yaml 14.4 / 14.1 s against 18.6 / 18.3 s, windy_case1.yaml 12.6 / 12.6 s
+# against 16.1 / 15.6 s, default.yaml 8.0 / 8.0 s against 9.2 / 9.6 s; the inelastic bench's
+# photon loop (10^5 photons, 2 threads, three interleaved rounds of 3 runs) 0.93-1.00 s against
+# 1.05-1.18 s; every output of every config and validation scene bit for bit the same.
 KERNEL_LOOP_UNROLLING = False
 # Machine code without LLVM's loop strength reduction (its option --disable-lsr, read when
 # the code generator's passes are set up), 9% of the machine code's passes for trace_batch
