@@ -110,6 +110,14 @@ machine): default.yaml 12.7 / 16.6 s against 11.7 / 11.7 s, shallow_sand_spectra
 raman_fluorescence.yaml 21.4 / 22.9 s against 20.0 / 19.0 s; deep_chlorophyll_maximum.yaml,
 which uses none of them, 14.6 / 15.6 s against 14.7 / 16.4 s (every output the same bit for
 bit).
+LLVM's loop unrolling and loop strength reduction, off for the loop since kernel 7b22a15
+(kernel/compile.py kernel_optimisation, which compile_part uses: measurements there), took 1.4
+to 4.2 s off the cold starts. Tried beside them the same day (2026-11-29, each variant compiled
+cold in a process of its own, two interleaved rounds, loop times medians of 5) and not kept:
+LLVM level 2 for the kernel's IR, compiled 0.1-1.4 s later, the inelastic bench's scene 0.673 /
+0.623 s against 0.643 / 0.601 s, default.yaml 0.780 / 0.770 s against 0.805 / 0.797 s,
+bare_walk.yaml and windy_case1.yaml alike; the loop vectoriser's interleaving off as well, no
+faster anywhere (inelastic 0.669 / 0.628 s) and compiled as long.
 """
 from __future__ import annotations
 
