@@ -226,10 +226,10 @@ KERNEL_OPT_LEVEL = 1
 # 1.05-1.18 s; every output of every config and validation scene bit for bit the same.
 KERNEL_LOOP_UNROLLING = False
 # Machine code without LLVM's loop strength reduction (its option --disable-lsr, read when
-# the code generator's passes are set up), 9% of the machine code's passes for trace_batch
-# (LLVM's pass timings; 0.86 s of 4.2 s for the inelastic variant): measured the same day,
-# with loop unrolling off in both, each variant compiled cold in a process of its own,
-# interleaved: compiled 0.0-1.6 s sooner (0.6 s on the mean of 10 pairs over four scenes), and
+# the code generator's passes are set up), a fifth of the machine code's passes for
+# trace_batch (LLVM's pass timings: 0.86 s of 4.2 s for the inelastic variant): measured the
+# same day, with loop unrolling off in both, each variant compiled cold in a process of its
+# own, interleaved: compiled 0.0-1.6 s sooner (0.6 s on the mean of 10 pairs over four scenes), and
 # the photon loop as fast (loop times, medians of 5, four rounds: bare_walk, 10^6 photons on
 # one thread, 0.151 / 0.148 / 0.154 / 0.151 s against 0.150 / 0.148 / 0.150 / 0.150 s; the
 # inelastic bench's scene 0.613 / 0.674 / 0.660 / 0.604 s against 0.643 / 0.746 / 0.638 /
