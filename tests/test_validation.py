@@ -140,6 +140,38 @@ def test_hotelling_of_proportional_estimates_has_their_rank():
     assert hotelling_z(diff, est.loo) == pytest.approx(expected, rel=1e-6)
 
 
+def test_hotelling_leaves_out_directions_of_negligible_variance():
+    """Six members that are one shape up to a fine structure holding about 1e-7 of the variance
+    (stats.RANK_RTOL 1e-5) are one test, as exact multiples are; a contrast between them holding
+    about 1e-3 of it is kept, and a bias of 8 of its standard errors along it is found although
+    it moves no member's own z by more than 0.3."""
+    from scipy import stats as st
+    from oceanmc.validation.stats import hotelling_z
+    rng = np.random.default_rng(5)
+    x = 1.0 + 0.1 * rng.normal(size=32)
+    scale = np.linspace(1.0, 2.0, 6)
+    one = JK.from_batches(x)
+    z1 = float((one.value - 0.99) / one.stderr)
+    expected = st.norm.isf(st.f.sf(z1 * z1, 1, 31))
+    fine = JK.from_batches(x[:, None] * scale + 0.1 * 3e-4 * rng.normal(size=(32, 6)))
+    lam = np.linalg.eigvalsh(np.corrcoef(fine.loo.T))
+    assert 1e-9 < lam[-2] / lam[-1] < 1e-6
+    assert hotelling_z(fine.value - 0.99 * scale, fine.loo) == pytest.approx(expected, rel=1e-3)
+    # a contrast orthogonal to the shape (each member's deviation from the mean, less its
+    # projection on the shape)
+    contrast = scale - scale.mean()
+    contrast -= (contrast @ scale) / (scale @ scale) * scale
+    contrast /= np.linalg.norm(contrast)
+    y = rng.normal(size=32)
+    kept = JK.from_batches(x[:, None] * scale + 0.1 * 0.05 * y[:, None] * contrast)
+    lam = np.linalg.eigvalsh(np.corrcoef(kept.loo.T))
+    assert 1e-4 < lam[-2] / lam[-1] < 1e-2
+    along = kept.apply(lambda v: v @ contrast)
+    diff = kept.value - 0.99 * scale + 8.0 * float(along.stderr) * contrast
+    assert np.max(np.abs(8.0 * float(along.stderr) * contrast / kept.stderr)) < 0.3
+    assert hotelling_z(diff, kept.loo) > 4.0
+
+
 def test_case_bounds_are_bonferroni_over_the_case():
     """After run_case, the bounds of a case's checks split the family-wise false alarm
     FAMILY_ALPHA over all its statistical checks: the members of groups get t quantiles for
