@@ -37,6 +37,7 @@ from .geometry import from_angles
 from .packet import weights
 from .phase import dispatch as phase
 from .phase import quadratic
+from .records import CAP_POINT_FLOATS
 from .rng import uniform
 from .surface import dispatch as surface_bsdf
 from .tally import deposit, deposit_range
@@ -66,11 +67,14 @@ def cap_transmissions(grid, work):
     the others read them (measured on the inelastic bench's scene, Raman and fluorescence: the
     cap scores took half the run's time; a scene without inelastic light computes them as it
     scores: through the scratch row, its one-wavelength nadir cap lost 8% of its photons/s).
-    The third view, one float, is 1 once they are computed at this event (collide sets it to
-    0 at every collision of a scene with inelastic light)."""
+    The third view holds the rest of what the first cap score found for the point (cap_point):
+    1 once it has (collide sets it to 0 at every collision of a scene with inelastic light),
+    the alpha node, the fraction to the next, the number of levels above and the roulette's
+    scale (0: the point lost it)."""
     n = grid.n_wl
     at = (3 + grid.n_parts) * n
-    return work[at:at + n], work[at + n:at + 2 * n], work[at + 2 * n:at + 2 * n + 1]
+    point = at + 2 * n
+    return work[at:at + n], work[at + n:point], work[point:point + CAP_POINT_FLOATS]
 
 
 @internal
@@ -78,7 +82,7 @@ def cap_scratch(grid, work):
     """Views (n_wl each) of a cap score's values at each wavelength and of the transmissions
     it carries from level to level, after cap_transmissions' (records.work_size)."""
     n = grid.n_wl
-    at = (5 + grid.n_parts) * n + 1
+    at = (5 + grid.n_parts) * n + CAP_POINT_FLOATS
     return work[at:at + n], work[at + n:at + 2 * n]
 
 
@@ -216,38 +220,26 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
     first .. last - 1 (weights `weight`; optical depths `tau` at every wavelength; the
     transmissions of the event's first cap score, cap_transmissions)."""
     n = grid.n_wl
-    # the node of the cap tables' alpha grid (uniform on two pieces) below the angle
-    # between the packet's direction and straight up, and the fraction to the next
-    alpha = math.acos(min(1.0, max(-1.0, -uz)))
-    if alpha < est.fine_end:
-        x = alpha / est.fine_step
+    if grid.n_parts > 1:
+        # a collision's elastic light and each of its emissions are scored from one point:
+        # the first of their cap scores finds its node, levels and roulette (over every
+        # wavelength) and its transmissions, and the others read them (each its own took
+        # 4% of the inelastic bench's collision time, by cycle counters)
+        to_level, to_air, point = cap_transmissions(grid, work)
+        if point[0] == 0.0:
+            i, f, above, scale = cap_point(est, grid, floats, tau, z, uz, 0, n, rng)
+            point[0] = 1.0
+            point[1] = i
+            point[2] = f
+            point[3] = above
+            point[4] = scale
+            if scale > 0.0:
+                spectral_transmissions(est, floats, grid, tau, above, 0, n, to_level, to_air)
+        i, f, above, scale = int(point[1]), point[2], int(point[3]), point[4]
     else:
-        x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
-    i = min(int(x), est.n_alpha - 2)
-    f = x - i
-    above = 0   # the tally levels at or above the point (sorted by depth)
-    while above < grid.n_depths and floats[grid.level_z + above] <= z:
-        above += 1
-    # roulette on the cap's scores: when even the least attenuated wavelength keeps less
-    # than CAP_ROULETTE of its light on the way to the nearest level above (or to the
-    # surface), the point scores with probability t / CAP_ROULETTE and its scores are
-    # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
-    # which send almost nothing up, cost a comparison instead of n_wl table reads
-    least = math.inf
-    if above > 0:
-        at = grid.level_tau + (above - 1) * n + first
-        nearest = floats[at:at + last - first]
-        for j in range(last - first):
-            least = min(least, tau[first + j] - nearest[j])
-    else:
-        for j in range(first, last):
-            least = min(least, tau[j])
-    scale = 1.0
-    kept = math.exp(-least)
-    if kept < CAP_ROULETTE:
-        if uniform(rng) * CAP_ROULETTE >= kept:
-            return
-        scale = CAP_ROULETTE / kept
+        i, f, above, scale = cap_point(est, grid, floats, tau, z, uz, first, last, rng)
+    if scale == 0.0:
+        return
     # (see scene/estimates.py for the expansion and its accuracy; the tables' M0, M1 linear in
     # alpha between nodes i and i + 1; no division per wavelength: each is a product with a
     # reciprocal taken once, which changed the scores by rounding only)
@@ -273,14 +265,11 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
         deposit(grid, tally, share, grid.cap + grid.n_depths, 0, air_cap_score(
             weight[0] * air_factor, air_t, m0, m1, tau[0], est.h, h_per_mu2, est.dh))
         return
-    # with inelastic light, the point's transmissions are computed once (cap_transmissions);
-    # a scene without it computes them for the wavelengths it scores
-    to_level, to_air, computed = cap_transmissions(grid, work)
+    # with inelastic light, the point's transmissions were computed with it (above); a scene
+    # without it computes them for the wavelengths it scores
+    to_level, to_air, _ = cap_transmissions(grid, work)
     if grid.n_parts == 1:
         spectral_transmissions(est, floats, grid, tau, above, first, last, to_level, to_air)
-    elif computed[0] == 0.0:
-        computed[0] = 1.0
-        spectral_transmissions(est, floats, grid, tau, above, 0, n, to_level, to_air)
     # the scores one level at a time over the wavelengths first .. last - 1, through views
     # that start at 0, which LLVM vectorises (per wavelength, they took a third of the
     # inelastic bench's run)
@@ -323,6 +312,47 @@ def cap_scores(est, grid, floats, ints, tally, share, work, weight, tau, z, uz, 
                                  g * m1_lo[j] + f * m1_hi[j], tau_j[j], est.h, h_per_mu2,
                                  est.dh)
     deposit_range(grid, tally, share, grid.cap + grid.n_depths * n, first, 1.0, value)
+
+
+@internal
+def cap_point(est, grid, floats, tau, z, uz, first, last, rng):
+    """(i, f, above, scale) of a point at depth z (optical depths tau) that scatters a packet
+    travelling with direction cosine uz: the node of the cap tables' alpha grid (uniform on
+    two pieces) below the angle between the packet's direction and straight up and the
+    fraction f to the next, the number of tally levels at or above the point (sorted by
+    depth), and the cap roulette's factor for the wavelengths first .. last - 1 (0: lost)."""
+    n = grid.n_wl
+    alpha = math.acos(min(1.0, max(-1.0, -uz)))
+    if alpha < est.fine_end:
+        x = alpha / est.fine_step
+    else:
+        x = (est.fine_nodes - 1) + (alpha - est.fine_end) / est.coarse_step
+    i = min(int(x), est.n_alpha - 2)
+    f = x - i
+    above = 0   # the tally levels at or above the point (sorted by depth)
+    while above < grid.n_depths and floats[grid.level_z + above] <= z:
+        above += 1
+    # roulette on the cap's scores: when even the least attenuated wavelength keeps less
+    # than CAP_ROULETTE of its light on the way to the nearest level above (or to the
+    # surface), the point scores with probability t / CAP_ROULETTE and its scores are
+    # divided by it (unbiased; Kalos & Whitlock 2008, 4.2): deep collisions in turbid water,
+    # which send almost nothing up, cost a comparison instead of n_wl table reads
+    least = math.inf
+    if above > 0:
+        at = grid.level_tau + (above - 1) * n + first
+        nearest = floats[at:at + last - first]
+        for j in range(last - first):
+            least = min(least, tau[first + j] - nearest[j])
+    else:
+        for j in range(first, last):
+            least = min(least, tau[j])
+    scale = 1.0
+    kept = math.exp(-least)
+    if kept < CAP_ROULETTE:
+        if uniform(rng) * CAP_ROULETTE >= kept:
+            return i, f, above, 0.0
+        scale = CAP_ROULETTE / kept
+    return i, f, above, scale
 
 
 @internal
@@ -407,15 +437,14 @@ def at_bottom(est, grid, medium, bottom, surface, floats, ints, bp, tally, ps, w
 
 
 @internal
-def at_emission(est, grid, medium, surface, floats, ints, tally, work, p, layer, beta_at, table,
-                first, last, rng, with_rough_surface, with_facet_walk, with_exact_directions):
+def at_emission(est, grid, medium, surface, floats, ints, tally, work, weight, p, layer, beta_at,
+                table, first, last, rng, with_rough_surface, with_facet_walk,
+                with_exact_directions):
     """An inelastic emission at packet p's collision (its weights at each wavelength in
-    work[3 n:4 n], zero outside first .. last - 1, channels/inelastic.py; its phase function's
+    `weight`, zero outside first .. last - 1, channels/inelastic.py; its phase function's
     beta at floats[beta_at], its cap tables `table`): the radiance it sends in the exact
     directions (directions_from_point) and the polar-cap averages (cap_scores, as a
     collision's), scored in the emission's part of the tally row, where `tally` starts."""
-    n = grid.n_wl
-    weight = work[3 * n:4 * n]
     tau = scratch(grid, work)[1]   # the collision's (collision_depths)
     one_part = work[:0]   # (tally.deposit: all of it in the part where `tally` starts)
     if with_exact_directions is not None and est.directions_on:

@@ -199,16 +199,22 @@ def work_size(n_wl: int, n_parts: int = 1) -> int:
     """Floats of one event's scratch: a collision's volume scattering function at every
     wavelength (kernel/spectral.py), then a local estimate's weight, optical depth and phase
     function at every wavelength (kernel/local_estimate.py). An inelastic emission's weights
-    per unit coefficient, what it takes and what it emits use the first, second and fourth of
-    these rows (the third holds the collision point's optical depths, which its local estimates
-    read: local_estimate.collision_depths); what each inelastic process emits at a collision
-    waits in one more row each until the packet that carries it has turned
-    (kernel/channels/inelastic.py); last, the event's cap
-    transmissions, to the level above and to 0+, and whether they are computed yet
-    (local_estimate.cap_transmissions), and a cap score's values and the transmissions it
-    carries up (local_estimate.cap_scratch); with inelastic light, then the hero's posterior at
-    a collision (spectral.posterior_at)."""
-    return (8 if n_parts == 1 else 8 + n_parts) * n_wl + 1
+    per unit coefficient and what it takes use the first and second of these rows, and an
+    emission that starts a packet of its own the fourth (the third holds the collision point's
+    optical depths, which its local estimates read: local_estimate.collision_depths); what each
+    inelastic process emits at a collision for the packet to carry on is made in one more row
+    each, where it waits until the packet has turned (kernel/channels/inelastic.py); last, the
+    event's cap transmissions, to the level above and to 0+, and what the first cap score at
+    the point found (CAP_POINT_FLOATS; local_estimate.cap_transmissions), a cap score's values
+    and the transmissions it carries up (local_estimate.cap_scratch), and, with inelastic
+    light, the hero's posterior at a collision (spectral.posterior_at)."""
+    return (8 if n_parts == 1 else 8 + n_parts) * n_wl + CAP_POINT_FLOATS
+
+
+# the floats after a point's cap transmissions in the scratch row: whether the point's cap
+# scores are set up, its alpha node, the fraction to the next, the levels above it and the cap
+# roulette's factor (local_estimate.cap_transmissions)
+CAP_POINT_FLOATS = 5
 
 
 def record(dtype: np.dtype, **values) -> np.ndarray:

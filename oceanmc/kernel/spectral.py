@@ -78,6 +78,7 @@ from .phase import dispatch as phase
 from .phase import tabulated
 from .rng import uniform
 from .packet import belong_to, free_path_at, weights
+from .records import CAP_POINT_FLOATS
 from .tally import deposit, deposit_all, spectral_at
 
 # a K_j past this, or positive below its inverse, settles the packet (its exponentials bring
@@ -282,7 +283,7 @@ def collision_density(medium, floats, grid, ps, p, layer, weight, posterior):
 def posterior_at(grid):
     """Where the hero's posterior at a collision (collision_density; n_wl) lies in the
     scratch row, last (records.work_size); a scene without inelastic light has none."""
-    return (7 + grid.n_parts) * grid.n_wl + 1
+    return (7 + grid.n_parts) * grid.n_wl + CAP_POINT_FLOATS
 
 
 @kernel

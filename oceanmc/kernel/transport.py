@@ -235,8 +235,7 @@ def collide(medium, surface, ctrl, grid, est, floats, ints, tally, ps, work, sta
                                    work[at:at + grid.n_wl if with_inelastic is not None
                                         and carrying else at])
     if with_inelastic is not None and grid.n_parts > 1:
-        # a new point: its cap transmissions are not computed yet
-        # (local_estimate.cap_transmissions)
+        # a new point: its cap scores are not set up yet (local_estimate.cap_transmissions)
         local_estimate.cap_transmissions(grid, work)[2][0] = 0.0
     if with_local_estimates is not None and (est.directions_on or est.cap_on):
         # (read by the local estimates and the emissions')

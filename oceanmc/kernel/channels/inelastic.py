@@ -94,9 +94,12 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
     estimate = est.directions_on or est.cap_on
     if not (spawn or estimate or carrying):
         return n_stacked
-    emission = work[3 * n:4 * n]   # (the third row holds the point's optical depths)
-    for i in range(n):
-        emission[i] = 0.0
+    # a carried emission is made in the channel's row, where carry() reads it, and a packet's
+    # own in the fourth row (the third holds the point's optical depths)
+    emission = kept if carrying else work[3 * n:4 * n]
+    if not carrying:
+        for i in range(n):
+            emission[i] = 0.0
     first_emitted = ints[medium.channel_emits + 2 * k]
     after_emitted = ints[medium.channel_emits + 2 * k + 1]
     if ints[medium.channel_separable + k]:
@@ -128,9 +131,6 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
                 out = emission[lo:lo + width]
                 for i in range(width):
                     out[i] += x * row[i]
-    if carrying:
-        for i in range(n):
-            kept[i] = emission[i]
     part = channel
     child_part = part * part_size
     if with_local_estimates is not None and estimate:
@@ -138,10 +138,11 @@ def emit(channel, medium, surface, ctrl, grid, est, floats, ints, tally_row, wor
         # that carries the emission, or the emitted packet, scores its light after it
         # scatters)
         local_estimate.at_emission(est, grid, medium, surface, floats, ints,
-                                   tally_row[child_part:child_part + part_size], work, p, layer,
-                                   medium.channel_beta + channel, est.emission_tables + k,
-                                   first_emitted, after_emitted, rng_emitted,
-                                   with_rough_surface, with_facet_walk, with_exact_directions)
+                                   tally_row[child_part:child_part + part_size], work,
+                                   emission, p, layer, medium.channel_beta + channel,
+                                   est.emission_tables + k, first_emitted, after_emitted,
+                                   rng_emitted, with_rough_surface, with_facet_walk,
+                                   with_exact_directions)
     if not spawn:
         return n_stacked
     shifted_in = child_part + spectral_at(grid, grid.budget + BUDGET_SHIFTED_IN)
