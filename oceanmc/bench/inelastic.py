@@ -90,7 +90,23 @@ which start and end anywhere, do not vectorise as the whole rows do. With the em
 1,900 cycles, the collision's own 3-part local estimates at 910 and the carry at 800, the 2x
 target needs an inelastic collision at about 3,100 cycles against an elastic one's 1,830 (at
 equal collisions per photon, 1.17 million per 10^5 photons in both, and the Raman part's 1.16
-times the elastic run's variance per photon): no part of it alone gives that."""
+times the elastic run's variance per photon): no part of it alone gives that.
+
+Kernel ea34c3e (2026-11-29, session 26): a collision's cap scores share one set-up of the point
+(local_estimate.cap_point: the alpha node, the levels above, the roulette over every wavelength
+and the transmissions, found by the first cap score and read by the emissions'), and a carried
+emission is made in its channel's row instead of being copied there. This section's scene, the
+inelastic photon loop, 60,000 photons, 2 threads, medians of 5, four interleaved rounds: 0.570 /
+0.574 / 0.560 / 0.599 s against 0.614 / 0.602 / 0.608 / 0.644 s (-7%; -8% over seven pairs in
+session 25). The section's own rows, whose simulate() runs move 10-20% on this machine, did not
+resolve it, with its repeats raised from 3 to 5 (80,004 photons/s against 82,867 from 3 repeats
+with kernel 7b22a15; the Raman ratio 3.6x in both). Raman scattering alone (no fluorescence; 5
+interleaved rounds of 10^5 photons, kernel 7b22a15): 2.62x the elastic run's time, the Raman
+part to 1% in 2.95x its time. Tried the same day and not kept: each part of the collision as a
+call of its own instead of inlined (the local estimates, the emissions, the whole collision): no
+faster (0.578-0.669 s against 0.592-0.668 s), and hero wavelengths drawn with hero_exponent 0 /
+1 / 2: the Raman ratio 3.92 / 3.47 / 3.97 (3 seeds each).
+"""
 from __future__ import annotations
 
 import time
@@ -162,7 +178,7 @@ def _run(config: dict) -> tuple[float, dict]:
 
 def measure(quick: bool, say) -> dict:
     photons = 10_000 if quick else 100_000
-    repeats = 1 if quick else 3
+    repeats = 1 if quick else 5
     for _, inelastic, estimator in RUNS:   # warm-up: compilation and the tables
         simulate(scene(2 * BATCHES, 99, inelastic, estimator), threads=2)
     times = {label: [] for label, _, _ in RUNS}
