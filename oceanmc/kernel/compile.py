@@ -247,7 +247,9 @@ KERNEL_LOOP_STRENGTH_REDUCTION = False
 # 0.990 s; default.yaml and bare_walk.yaml (one wavelength) as fast; the inelastic scene (37
 # bands, a remainder of 5) 0.524 / 0.540 / 0.541 / 0.556 / 0.603 -> 0.521 / 0.543 / 0.512 /
 # 0.612 / 0.549 s. Compiled as fast or faster (less code: 4.7 -> 4.1 s, 14.3 -> 13.4 s, one
-# cold compilation each).
+# cold compilation each). Every output is the same bit for bit (benchmarks/regression.md), on
+# any machine; the speed is measured on this one only (AMD znver5): where masked loads are slow
+# (AVX2 without AVX-512) it is not known whether folding pays.
 KERNEL_TAIL_FOLDING = True
 
 
@@ -266,11 +268,11 @@ def _kernel_pass_builder(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
 @contextmanager
 def kernel_optimisation():
     """Numba compiles with the kernel's LLVM settings (KERNEL_OPT_LEVEL, KERNEL_LOOP_UNROLLING,
-    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING) inside this block: run/compiling.py compiles the photon
-    loop's variants in it. (Numba builds its pass managers anew for every function, from its
-    config and its module's create_pass_builder, which this replaces while it lasts, and LLVM
-    reads its options when it sets up the code generator's passes; another Numba than 0.68
-    keeps its own pass builder.)"""
+    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING) inside this block: run/compiling.py
+    compiles the photon loop's variants in it. (Numba builds its pass managers anew for every
+    function, from its config and its module's create_pass_builder, which this replaces while it
+    lasts, and LLVM reads its options when it sets up the code generator's passes; another Numba
+    than 0.68 keeps its own pass builder.)"""
     previous_level = numba.config.OPT
     previous_builder = getattr(numba_codegen, "create_pass_builder", None)
     numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
