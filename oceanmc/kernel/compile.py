@@ -249,7 +249,11 @@ KERNEL_LOOP_STRENGTH_REDUCTION = False
 # 0.612 / 0.549 s. Compiled as fast or faster (less code: 4.7 -> 4.1 s, 14.3 -> 13.4 s, one
 # cold compilation each). Every output is the same bit for bit (benchmarks/regression.md), on
 # any machine; the speed is measured on this one only (AMD znver5): where masked loads are slow
-# (AVX2 without AVX-512) it is not known whether folding pays.
+# (AVX2 without AVX-512) it is not known whether folding pays. Only variants with the spectral
+# walk fold (kernel_optimisation's tail_folding): a one-wavelength loop has no wavelength loops
+# to gain, and the rough sea's table lost by it on the surface bench's one-wavelength scene
+# (its photons/s over the flat sea's 0.60 / 0.58 / 0.65 against 0.66 / 0.74 without, three and
+# two runs).
 KERNEL_TAIL_FOLDING = True
 
 
@@ -266,20 +270,20 @@ def _kernel_pass_builder(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
 
 
 @contextmanager
-def kernel_optimisation():
+def kernel_optimisation(tail_folding: bool = True):
     """Numba compiles with the kernel's LLVM settings (KERNEL_OPT_LEVEL, KERNEL_LOOP_UNROLLING,
-    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING) inside this block: run/compiling.py
-    compiles the photon loop's variants in it. (Numba builds its pass managers anew for every
-    function, from its config and its module's create_pass_builder, which this replaces while it
-    lasts, and LLVM reads its options when it sets up the code generator's passes; another Numba
-    than 0.68 keeps its own pass builder.)"""
+    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING where tail_folding) inside this block:
+    run/compiling.py compiles the photon loop's variants in it. (Numba builds its pass managers
+    anew for every function, from its config and its module's create_pass_builder, which this
+    replaces while it lasts, and LLVM reads its options when it sets up the code generator's
+    passes; another Numba than 0.68 keeps its own pass builder.)"""
     previous_level = numba.config.OPT
     previous_builder = getattr(numba_codegen, "create_pass_builder", None)
     numba.config.OPT = _OptLevel(KERNEL_OPT_LEVEL)
     if LINK_ONLY and previous_builder is not None:
         numba_codegen.create_pass_builder = _kernel_pass_builder
     llvm.set_option("", f"--disable-lsr={str(not KERNEL_LOOP_STRENGTH_REDUCTION).lower()}")
-    if KERNEL_TAIL_FOLDING:
+    if KERNEL_TAIL_FOLDING and tail_folding:
         llvm.set_option("", "--prefer-predicate-over-epilogue=predicate-else-scalar-epilogue")
     try:
         yield

@@ -206,8 +206,9 @@ def parts(variant: Variant) -> dict[str, tuple[tuple, ...]]:
 
 def compile_part(name: str, variant: Variant) -> None:
     """Compiles one part of a variant with the kernel's LLVM settings (kernel/compile.py
-    kernel_optimisation; the child process runs this too)."""
-    with kernel_optimisation():
+    kernel_optimisation, whose tail folding only spectral variants take; the child process runs
+    this too)."""
+    with kernel_optimisation(tail_folding=variant.spectral):
         for dispatcher, sig in parts(variant)[name]:
             dispatcher.compile(sig)
 
