@@ -249,12 +249,30 @@ KERNEL_LOOP_STRENGTH_REDUCTION = False
 # 0.612 / 0.549 s. Compiled as fast or faster (less code: 4.7 -> 4.1 s, 14.3 -> 13.4 s, one
 # cold compilation each). Every output is the same bit for bit (benchmarks/regression.md), on
 # any machine; the speed is measured on this one only (AMD znver5): where masked loads are slow
-# (AVX2 without AVX-512) it is not known whether folding pays. Only variants with the spectral
-# walk fold (kernel_optimisation's tail_folding): a one-wavelength loop has no wavelength loops
-# to gain, and the rough sea's table lost by it on the surface bench's one-wavelength scene
-# (its photons/s over the flat sea's 0.60 / 0.58 / 0.65 against 0.66 / 0.74 without, three and
-# two runs).
+# (AVX2 without AVX-512) it does not pay, so only machine code for AVX-512, whose mask
+# registers make a masked iteration as cheap as a full one, folds (masked_vectors): the same
+# kernel compiled for AVX2 (NUMBA_CPU_NAME=haswell with Haswell's features, run on this
+# machine, 2026-11-29, three interleaved rounds) was slower with folding, the elastic scene
+# 0.371 / 0.388 / 0.347 s against 0.355 / 0.362 / 0.335 s, case1_spectral.yaml 0.535 / 0.533 /
+# 0.490 against 0.512 / 0.528 / 0.494 s, the inelastic scene (6 * 10^4 photons) 0.703 / 0.677 /
+# 0.653 against 0.670 / 0.604 / 0.578 s (AVX2's masked moves are slow on AMD's cores; Intel's
+# AVX2 cores were not measured). Only variants with the spectral walk fold
+# (kernel_optimisation's tail_folding): a one-wavelength loop has no wavelength loops to gain,
+# and the rough sea's table lost by it on the surface bench's one-wavelength scene (its
+# photons/s over the flat sea's 0.60 / 0.58 / 0.65 against 0.66 / 0.74 without, three and two
+# runs).
 KERNEL_TAIL_FOLDING = True
+
+
+def masked_vectors() -> bool:
+    """Whether the machine code Numba makes here has AVX-512's masked vector operations (the
+    target's features: NUMBA_CPU_FEATURES where set, else the host's, as Numba chooses them;
+    its cache keeps machine code per CPU name and features, so a cached kernel was folded or
+    not as this says)."""
+    features = numba.config.CPU_FEATURES
+    if features is None:
+        features = numba_codegen.get_host_cpu_features()
+    return "+avx512f" in features.split(",")
 
 
 def _kernel_pass_builder(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
@@ -272,7 +290,8 @@ def _kernel_pass_builder(tm, opt=2, loop_vectorize=False, slp_vectorize=False):
 @contextmanager
 def kernel_optimisation(tail_folding: bool = True):
     """Numba compiles with the kernel's LLVM settings (KERNEL_OPT_LEVEL, KERNEL_LOOP_UNROLLING,
-    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING where tail_folding) inside this block:
+    KERNEL_LOOP_STRENGTH_REDUCTION, KERNEL_TAIL_FOLDING where tail_folding and the target has
+    AVX-512: masked_vectors) inside this block:
     run/compiling.py compiles the photon loop's variants in it. (Numba builds its pass managers
     anew for every function, from its config and its module's create_pass_builder, which this
     replaces while it lasts, and LLVM reads its options when it sets up the code generator's
@@ -283,7 +302,7 @@ def kernel_optimisation(tail_folding: bool = True):
     if LINK_ONLY and previous_builder is not None:
         numba_codegen.create_pass_builder = _kernel_pass_builder
     llvm.set_option("", f"--disable-lsr={str(not KERNEL_LOOP_STRENGTH_REDUCTION).lower()}")
-    if KERNEL_TAIL_FOLDING and tail_folding:
+    if KERNEL_TAIL_FOLDING and tail_folding and masked_vectors():
         llvm.set_option("", "--prefer-predicate-over-epilogue=predicate-else-scalar-epilogue")
     try:
         yield
