@@ -101,12 +101,22 @@ def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0,
         raise UsageError(f"{path} exists; pass --overwrite to replace it"
                          + (" (or --resume to continue a partial run)" if resumable else ""))
     folder = path.parent if str(path.parent) else Path(".")
+    # (mkdir alone says "File exists" of a folder path through a file, and an unwritable
+    # system folder such as /proc may answer "No such file or directory")
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise UsageError(f"cannot write results to {path}: {existing} is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UsageError(f"cannot make the folder {folder} for the results: "
+                         f"{exc.strerror or exc}") from None
+    try:
         with tempfile.NamedTemporaryFile(dir=folder, prefix=".oceanmc-write-test-"):
             pass
     except OSError as exc:
-        raise UsageError(f"cannot write results to {folder}: {exc.strerror or exc}") from None
+        raise UsageError(f"cannot write results to {folder}: a new file there cannot be made "
+                         f"({exc.strerror or exc})") from None
     free = shutil.disk_usage(folder).free
     if free < 2 * need_bytes:
         raise UsageError(f"not enough disk space in {folder}: about {need_bytes / 1e6:.1f} MB "
@@ -190,12 +200,15 @@ def cmd_run(args: argparse.Namespace) -> int:
               else f"oceanmc: config error: {exc}", file=sys.stderr)
         return 2
 
-    loaded = []
+    # every config is checked, and each bad one named, before any is run
+    loaded, bad = [], 0
     for path in configs:
         try:
             loaded.append(load_config(path, overrides))
         except ConfigError as exc:
-            return config_error(path, exc)
+            bad = config_error(path, exc)
+    if bad:
+        return bad
     # the photon loop is compiled (or loaded) before any scene is packed: the packers call
     # kernel functions, which the compiling child process then compiles off the critical path,
     # and it packs the scenes while trace_batch compiles (run/compiling.py; packing first
@@ -207,7 +220,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             # reads its data files: every scene is checked before any runs
             run = prepare(config)
         except ConfigError as exc:
-            return config_error(path, exc)
+            bad = config_error(path, exc)
+            continue
         _check_writable(out, args.overwrite or (args.resume and out.exists()),
                         _file_size_estimate(run.config))
         previous = None
@@ -220,6 +234,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"oceanmc: --resume: no file at {out} to continue; running {path} from the "
                   "start", file=sys.stderr, flush=True)
         scenes.append((path, run, RunFile(out, previous, args.overwrite)))
+    if bad:
+        return bad
 
     stop = StopRequest()
     stop.install()
@@ -563,8 +579,9 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--depth", type=float, metavar="Z",
                       help="tallied depth (m) of the radiance plot (default: 0, just below)")
     plot.add_argument("--wavelength", type=float, metavar="NM",
-                      help="draw this wavelength only (default: a few across the spectrum; "
-                           "the middle one for the radiance)")
+                      help="the profiles and the radiance at this wavelength only (default: "
+                           "a few across the spectrum; the middle one for the radiance); the "
+                           "Rrs and K, R spectra stay whole")
     plot.set_defaults(func=cmd_plot)
     return parser
 

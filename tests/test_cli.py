@@ -84,9 +84,14 @@ def test_bad_config_exits_2_with_one_clear_line_and_no_file(tmp_path, small_scen
 def test_a_bad_config_among_several_stops_before_any_run(tmp_path, scene_file):
     bad = tmp_path / "bad.yaml"
     bad.write_text("water: {layers: [{thickness_m: 1, a: 0.1, b: 0.1}]}\nbottom: {model: mud}\n")
-    done = oceanmc("run", scene_file, bad, cwd=tmp_path)
+    worse = tmp_path / "worse.yaml"
+    worse.write_text(scene_file.read_text().replace("photons:", "photonz:"))
+    done = oceanmc("run", scene_file, bad, worse, cwd=tmp_path)
     assert done.returncode == 2
-    assert "bottom.model = 'mud'" in done.stderr
+    # each bad config named in a line of its own, not only the first
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 2 and "bottom.model = 'mud'" in lines[0], lines
+    assert "worse.yaml: photonz: unknown key; did you mean photons?" in lines[1], lines
     assert not (tmp_path / "results" / "scene.h5").exists()
 
 
@@ -233,6 +238,8 @@ def test_unwritable_output_fails_before_running(tmp_path, scene_file):
     (tmp_path / "blocker").write_text("a file, not a folder")
     done = oceanmc("run", scene_file, "-o", tmp_path / "blocker" / "r.h5", cwd=tmp_path)
     assert done.returncode == 2 and "cannot write" in done.stderr
+    # the file in the way is named (mkdir's own words were "File exists")
+    assert f"{tmp_path / 'blocker'} is a file, not a folder" in done.stderr, done.stderr
     assert "photons/s" not in done.stdout
 
 

@@ -154,4 +154,9 @@ def test_a_spectral_file_plots_kd_and_r(tmp_path, capsys):
     assert main(["show", str(path)]) == 0
     table = capsys.readouterr().out.split("derived (")[1]
     assert "Kd(0-..5 m)" in table and "R(0-)" in table
+    # in blocks of columns, the K functions and the ratios apart, as the run's own table: every
+    # line fits 100 characters (one block of all nine was 170 wide)
+    assert max(len(line) for line in table.splitlines()) <= 100
+    k_heading = next(line for line in table.splitlines() if "Kd(0-..5 m)" in line)
+    assert "R(0-)" not in k_heading
     assert ("Q(0-)" in table) == ("Lu" in result)   # Q only where the run has a nadir radiance

@@ -36,13 +36,17 @@ def test_registry_lists_every_schema_constituent_and_its_module():
     assert all((folder / f"{m}.py").exists() for m in registry.CONSTITUENT.values())
 
 
-def test_pure_water_pope_fry_smith_baker_morel():
-    iop = layer([{"model": "pure_water"}], [300.0, 440.0, 550.0, 700.0, 800.0])
-    # Pope & Fry (1997) as printed (OMLC, 1/cm x 100): 440 nm 0.00635, 550 nm 0.0565, 700 nm
-    # 0.624; Smith & Baker (1981) Table 1 outside 380-727.5 nm: 300 nm 0.141, 800 nm 2.07
-    assert iop.a == pytest.approx([0.141, 0.00635, 0.0565, 0.624, 2.07], rel=1e-9)
+def test_pure_water_ioccg_pope_fry_morel():
+    wavelengths = [300.0, 350.0, 400.0, 420.0, 440.0, 550.0, 700.0, 800.0]
+    iop = layer([{"model": "pure_water"}], wavelengths)
+    # Pope & Fry (1997) as printed (OMLC, 1/cm x 100) from 420 nm: 420 nm 0.00454, 440 nm
+    # 0.00635, 550 nm 0.0565, 700 nm 0.624; outside, the IOCCG Protocols (2018): 300 nm 0.0147
+    # (Jonasz & Fournier 2007), 350 nm 0.0071, 400 nm 0.0046 (Morel et al. 2007 Table 2a),
+    # 800 nm 2.25 (Kou et al. 1993)
+    assert iop.a == pytest.approx([0.0147, 0.0071, 0.0046, 0.00454, 0.00635, 0.0565, 0.624,
+                                   2.25], rel=1e-9)
     # Morel (1974): b_sw = 0.00288 (lambda / 500)^-4.32; molecular scattering bb/b = 1/2
-    b = [0.00288 * (wl / 500.0) ** -4.32 for wl in (300.0, 440.0, 550.0, 700.0, 800.0)]
+    b = [0.00288 * (wl / 500.0) ** -4.32 for wl in wavelengths]
     assert iop.b == pytest.approx(b, rel=1e-12)
     assert iop.bb == pytest.approx(0.5 * np.array(b), rel=1e-12)
     assert [p.model for p in iop.phases] == ["pure_water"]

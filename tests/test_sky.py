@@ -435,8 +435,8 @@ def test_bad_sky_files(tmp_path):
 
 
 def test_sky_config(tmp_path):
-    with pytest.raises(ConfigError, match="'uniform', 'cardioidal', 'overcast' or "
-                                          "'harrison_coombes'"):
+    with pytest.raises(ConfigError, match="'uniform', 'cardioidal', 'overcast', "
+                                          "'harrison_coombes' or a mapping {map}"):
         load_config(base("clear"))
     with pytest.raises(ConfigError, match="illumination.sky.map: required key is missing"):
         load_config(base({"file": "x.npy"}))

@@ -95,7 +95,8 @@ def amount(limit: float, unit: str):
 
 
 class PureWaterComponent(_Strict):
-    """a_w: Pope & Fry (1997), 380-727.5 nm; Smith & Baker (1981) outside it (200-800 nm).
+    """a_w: Pope & Fry (1997), 420-727.5 nm; outside it (180-1230 nm) the IOCCG Protocols
+    (2018)'s recommended spectrum (Morel et al. 2007, Jonasz & Fournier 2007, Kou et al. 1993).
     b_w: pure sea water, Morel (1974), 0.00288 (lambda/500)^-4.32; phase 0.06225 (1 + 0.835
     cos^2)."""
     model: Literal["pure_water"]

@@ -84,8 +84,9 @@ class CdomFluorescence(_Strict):
     multiplies Hawes's quantum efficiency (his A0 table) for a CDOM that fluoresces more or
     less than his fulvic acid; at most 50, which keeps Phi below 1 (0.95).
     excitation_range_nm: where absorbed light fluoresces, within Hawes's A0 table and
-    HydroLight's extension of it, 310-550 nm (the default: all of it; below 380 nm pure-water
-    absorption comes from Smith & Baker 1981, tabulated down to 200 nm)."""
+    HydroLight's extension of it, 310-550 nm (the default: all of it; below 420 nm pure-water
+    absorption comes from Morel et al. 2007 and Jonasz & Fournier 2007, tabulated down to
+    180 nm)."""
     a0_scale: Annotated[float, Field(ge=0.0, le=50.0, allow_inf_nan=False)] = 1.0
     excitation_range_nm: tuple[Positive, Positive] = CDOM_EXCITATION_RANGE_NM
 

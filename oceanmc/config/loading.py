@@ -2,10 +2,12 @@
 writing it back as YAML."""
 from __future__ import annotations
 
+import datetime
 import difflib
 import hashlib
 import json
 import os
+import re
 import stat
 import sys
 import textwrap
@@ -262,11 +264,20 @@ def _key_path(loc: tuple) -> str:
     return path or "(top level)"
 
 
+# a key's unit, left out when a misspelt key is matched (`chl: 1` or `b488: 3e-4`: the quantity
+# without its unit is close to none of the keys with it)
+_UNIT_SUFFIX = re.compile(r"_(per_m|mg_m3|m_s|deg|nm|m)$")
+
+
 def _suggestion(loc: tuple) -> str:
-    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close."""
+    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close (by the
+    whole key, or by the key without its unit)."""
     names = schema_keys(loc[:-1]) or set()
-    close = difflib.get_close_matches(str(loc[-1]), sorted(names), n=1, cutoff=0.6)
-    return f"; did you mean {close[0]}?" if close else " (check its spelling and level)"
+    by_stem = {_UNIT_SUFFIX.sub("", name): name for name in sorted(names)}
+    by_stem.update({name: name for name in names})
+    close = difflib.get_close_matches(str(loc[-1]), sorted(by_stem), n=1, cutoff=0.6)
+    return f"; did you mean {by_stem[close[0]]}?" if close else \
+        " (check its spelling and level)"
 
 
 def schema_keys(loc: tuple) -> set[str] | None:
@@ -325,8 +336,11 @@ def _annotations_at(loc: tuple) -> list[Any] | None:
 
 
 def _shown(value: Any) -> str:
-    """repr(value), except for an integer too long for it (more than 4300 digits: a
+    """repr(value), except for a time (YAML reads an unquoted one as a datetime: shown as
+    written, ISO 8601) and an integer too long for repr (more than 4300 digits: a
     ValueError)."""
+    if isinstance(value, (datetime.date, datetime.time)):
+        return value.isoformat()
     try:
         return repr(value)
     except ValueError:
@@ -360,7 +374,8 @@ def _describe(error: dict) -> str:
         return f"{path}.{key}: required key is missing"
     if path == "(top level)" and kind == "value_error":
         return msg
-    allowed = _allowed_range(error)
+    allowed = _allowed_range(error) or (_union_forms(tuple(error.get("loc", ())))
+                                         if kind in _WRONG_FORM else "")
     if allowed:
         msg = f"allowed: {allowed}"
     if "input" in error and not isinstance(error["input"], dict):
@@ -375,14 +390,49 @@ def _describe(error: dict) -> str:
 _BOUND_ERRORS = frozenset({"greater_than", "greater_than_equal", "less_than", "less_than_equal"})
 
 
+# and for a value that is not a number where one is needed (`chl_mg_m3: one`)
+_NOT_A_NUMBER = frozenset({"float_parsing", "float_type", "int_parsing", "int_type",
+                           "int_from_float"})
+
+
 def _allowed_range(error: dict) -> str:
-    """For a number beyond a bound, the range its key allows, in words (base.allowed_numbers:
-    pydantic's message names only the bound it broke, `Input should be greater than or equal
-    to 2`); '' for another error, or a location not found in the schema."""
-    if error.get("type") not in _BOUND_ERRORS:
+    """For a number beyond a bound, or a value that is no number where one is needed, the
+    numbers its key allows, in words (base.allowed_numbers: pydantic's message names only the
+    bound it broke, `Input should be greater than or equal to 2`, or none); '' for another
+    error, or a location not found in the schema."""
+    kind = error.get("type")
+    if kind not in _BOUND_ERRORS and kind not in _NOT_A_NUMBER:
         return ""
     annotations = _annotations_at(tuple(error.get("loc", ())))
-    return allowed_numbers(annotations, error.get("ctx")) if annotations else ""
+    broken = error.get("ctx") if kind in _BOUND_ERRORS else None
+    return allowed_numbers(annotations, broken) if annotations else ""
+
+
+# pydantic's types of the error for a value of the wrong form (not one a member's own checks
+# refused)
+_WRONG_FORM = frozenset({"list_type", "tuple_type", "literal_error", "dict_type", "model_type",
+                         "model_attributes_type"})
+
+
+def _union_forms(loc: tuple) -> str:
+    """For a value of the wrong form where a union chooses its member by the value's form (a
+    list or {start, stop, step} for wavelengths_nm; a sky's name or {map: FILE}): every form
+    the key allows, in words (pydantic names only those of the member it tried); '' for
+    another error."""
+    if not (loc and _is_branch_tag(loc[-1])):
+        return ""
+    forms = []
+    for annotation in _annotations_at(loc[:-1]) or []:
+        for member, _ in _alternatives(annotation):
+            bare = _bare(member)
+            if get_origin(bare) is Literal:
+                forms.append(", ".join(repr(v) for v in get_args(bare)))
+            elif get_origin(bare) in (list, tuple):
+                forms.append("a list")
+            elif isinstance(bare, type) and issubclass(bare, BaseModel):
+                keys = [name for name, field in bare.model_fields.items() if field.is_required()]
+                forms.append(f"a mapping {{{', '.join(keys)}}}")
+    return " or ".join(forms) if len(forms) > 1 else ""
 
 
 def _first_problem(errors: list[dict]) -> tuple[str, int]:
@@ -397,9 +447,12 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
     first = errors[0]
     if first.get("type") == "missing":
         for error in errors:
+            suggested = _suggestion(tuple(error.get("loc", ())))
             if error.get("type") == "extra_forbidden" and parent(error) == parent(first) \
-                    and _suggestion(tuple(error.get("loc", ()))).startswith("; did you mean"):
-                return _describe(error), 1
+                    and suggested.startswith("; did you mean"):
+                # (the missing key, when it is the one suggested, is the same problem)
+                missing = str(first["loc"][-1]) if first.get("loc") else ""
+                return _describe(error), 2 if suggested == f"; did you mean {missing}?" else 1
     loc = tuple(first.get("loc", ()))
     # (a member that is a model reports its own keys after the tag: described as they are)
     if not (loc and _is_branch_tag(loc[-1])) or isinstance(first.get("input"), dict):

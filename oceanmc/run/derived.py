@@ -34,6 +34,8 @@ from typing import Callable
 
 import numpy as np
 
+from .text_table import spectral_blocks, value_cell
+
 
 @dataclass(frozen=True)
 class Derived:
@@ -175,6 +177,16 @@ def _where(depth: float) -> str:
     return "0-" if depth == 0.0 else f"{depth:g} m"
 
 
+def _spectral_cell(value: float, err: float) -> str:
+    """A derived quantity's cell in a spectral table (text_table.value_cell): 'undefined' where a
+    ratio's denominator is 0, '?' for an error a batch left out leaves undefined."""
+    if math.isnan(value):
+        return "undefined"
+    if math.isnan(err):
+        return f"{value:>9.4g} {'?':>5}"
+    return value_cell(value, err)
+
+
 def format_derived(result) -> str:
     """The derived quantities as text for `oceanmc show`: a monochromatic file one row per
     quantity and depth (or interval), value, standard error and relative error; a spectral one a
@@ -207,19 +219,14 @@ def format_derived(result) -> str:
                 rel = f"{abs(err / value):>10.2%}" if value != 0.0 else f"{'-':>10}"
                 lines.append(f"  {label(d, i):<28}{d.units:<9}{value:>13.6g}{err:>12.3g}{rel}")
         return "\n".join(lines)
-    heads = [(label(d, 0), d) for d in derived.values()]
-    lines.append(f"  {'nm':>6}" + "".join(f" {head:>17}" for head, _ in heads))
-    for k, wavelength in enumerate(result.coords["wavelength"]):
-        cells = []
-        for _, d in heads:
-            value, err = d.value[k, 0], d.stderr[k, 0]
-            if math.isnan(value):
-                cells.append(f"{'undefined':>17}")
-                continue
-            rel = f"{'?':>6}" if math.isnan(err) else \
-                f"{abs(err / value):>6.1%}" if value != 0.0 else f"{'-':>6}"
-            cells.append(f"{value:>10.4g} {rel}")
-        lines.append(f"  {wavelength:>6g}" + "".join(f" {cell:>17}" for cell in cells))
+    # the K functions (over the first interval) in blocks of their own, then the ratios (at
+    # the first depth), as the run's own spectral table (text_table.spectral_blocks)
+    ordered = sorted(derived.values(), key=lambda d: "depth_interval" not in d.dims)
+    cells = [[_spectral_cell(d.value[k, 0], d.stderr[k, 0])
+              for k in range(len(result.coords["wavelength"]))] for d in ordered]
+    k_functions = sum("depth_interval" in d.dims for d in ordered)
+    lines += spectral_blocks(result.coords["wavelength"], [label(d, 0) for d in ordered], cells,
+                             (range(0, k_functions), range(k_functions, len(ordered))))
     note = ("(value and relative standard error; K in 1/m over the first interval of tally "
             "depths, the others at the first depth; Q in sr; every depth and interval in the "
             "file's group derived)")

@@ -10,6 +10,7 @@ import numpy as np
 
 from .derivation import budget_terms
 from .result import Result
+from .text_table import SUMMARY_WIDTH, spectral_blocks, value_cell
 
 
 def nadir_estimate(result: Result) -> str:
@@ -146,19 +147,6 @@ SPECTRAL_COLUMNS = (("Ed(0+)", "air/Ed", None), ("Rrs nadir", "air/Rrs_nadir", N
                     ("Eu(0+)", "air/Eu", None),
                     ("Ed(z1)", "Ed", 0), ("Eu(z1)", "Eu", 0), ("Eo(z1)", "Eo", 0),
                     ("leaving", "budget/water_leaving", None), ("total", "budget/total", None))
-
-
-# the printed summary fits a terminal this wide: a spectral table's nm column (8 characters)
-# and SPECTRAL_BLOCK columns of 16 (a value, its relative standard error)
-SUMMARY_WIDTH = 100
-SPECTRAL_BLOCK = (SUMMARY_WIDTH - 8) // 16
-
-
-def value_cell(value: float, err: float) -> str:
-    """A spectral table's cell of 15 characters: the value and its relative standard error in %
-    (0.0% for a value of 0)."""
-    rel = abs(err / value) if value != 0.0 else 0.0
-    return f"{value:>9.4g} {rel:>5.1%}"
 
 
 # the parts of the light (add_parts) as the summary's headings and the plots' legends name them
@@ -308,21 +296,12 @@ def format_spectrum(result: Result) -> list[str]:
                 value, err = value[index], err[index]
             column.append(value_cell(value, err))
         cells.append(column)
-    # the table is printed in blocks of at most SPECTRAL_BLOCK columns, each after the nm
-    # column, so that a line fits a terminal of SUMMARY_WIDTH characters: the quantities at
-    # the surface (Ed(0+), the Rrs columns, Eu(0+)) first, then those in the water and the budget
+    # the quantities at the surface (Ed(0+), the Rrs columns, Eu(0+)) first, then those in the
+    # water and the budget
     surface = next(i for i, (_, name, _) in enumerate(columns + [("", "Ed", 0)])
                    if name in ("Ed", "Eu", "Eo") or name.startswith("budget/"))
-    blocks = [range(start, min(start + SPECTRAL_BLOCK, end))
-              for begin, end in ((0, surface), (surface, len(columns)))
-              for start in range(begin, end, SPECTRAL_BLOCK)]
-    lines = []
-    for b, block in enumerate(blocks):
-        if b:
-            lines.append("")
-        lines.append(f"  {'nm':>6}" + "".join(f" {columns[c][0]:>15}" for c in block))
-        lines += [f"  {wavelength:>6g}" + "".join(f" {cells[c][k]:>15}" for c in block)
-                  for k, wavelength in enumerate(result.coords["wavelength"])]
+    lines = spectral_blocks(result.coords["wavelength"], [head for head, _, _ in columns], cells,
+                            (range(0, surface), range(surface, len(columns))))
     lines += rrs_parts_table(result)
     lines += estimator_lines(result)
     lines += inelastic_lines(result)

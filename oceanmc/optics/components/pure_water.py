@@ -1,7 +1,12 @@
 """Pure (sea) water.
 
-a_w: Pope & Fry (1997), Appl. Opt. 36, 8710 (380-727.5 nm); outside it Smith & Baker (1981),
-Appl. Opt. 20, 177, Table 1 (200-800 nm). Both tables in oceanmc/data with their provenance.
+a_w: the IOCCG Protocols (2018)'s recommended spectrum, 180-1230 nm: Pope & Fry (1997), Appl.
+Opt. 36, 8710, from 420 to 727.5 nm (at its 2.5 nm resolution); below, Morel et al. (2007),
+Limnol. Oceanogr. 52, 217, Table 2a (345-415 nm) and Jonasz & Fournier (2007) (180-340 nm);
+above, Kou et al. (1993), Appl. Opt. 32, 3531. Both tables in oceanmc/data with their
+provenance. (Until 2026-11-29 Smith & Baker (1981) below 380 nm, whose clearest natural waters
+absorb 2-7x more in the ultraviolet and met Pope & Fry at 380 nm with a step of 2.6x: the Raman
+light at 400-430 nm, excited at 345-375 nm, was too weak.)
 b_w: pure sea water after Morel (1974), b_w = 0.00288 (lambda/500)^-4.32 1/m (the power law that
 represents Morel's values; oceanmc/data/... README compares it with the printed table: within 1%
 to 550 nm), and its phase function 0.06225 (1 + 0.835 cos^2) (Morel 1974), bb/b = 1/2."""
@@ -17,16 +22,23 @@ MOREL_B500 = 0.00288
 MOREL_EXPONENT = 4.32
 
 
+# where the IOCCG (2018) spectrum takes Pope & Fry (1997) up (below it Morel et al. 2007, whose
+# 380-415 nm values are 0.5-1x Pope & Fry's and meet them here)
+POPE_FRY_FROM_NM = 420.0
+
+
 def absorption(wavelengths_nm: np.ndarray, where: str) -> np.ndarray:
     pope = packaged("pure_water_absorption_pope_fry_1997.csv")
-    smith = packaged("pure_water_absorption_smith_baker_1981.csv")
-    nodes = pope["wavelength_nm"]
-    inside = (wavelengths_nm >= nodes[0]) & (wavelengths_nm <= nodes[-1])
-    out = interpolate(wavelengths_nm, smith["wavelength_nm"], smith["a_w_per_m"], where,
-                      "pure-water absorption (Smith & Baker 1981)") if not inside.all() \
-        else np.empty_like(wavelengths_nm)
-    out[inside] = np.interp(wavelengths_nm[inside], nodes, pope["a_w_per_m"])
-    return out
+    beside = packaged("pure_water_absorption_ioccg_2018.csv")
+    pope_nodes, beside_nodes = pope["wavelength_nm"], beside["wavelength_nm"]
+    used = pope_nodes >= POPE_FRY_FROM_NM
+    below = beside_nodes < POPE_FRY_FROM_NM
+    above = beside_nodes > pope_nodes[-1]
+    nodes = np.concatenate([beside_nodes[below], pope_nodes[used], beside_nodes[above]])
+    values = np.concatenate([beside["a_w_per_m"][below], pope["a_w_per_m"][used],
+                             beside["a_w_per_m"][above]])
+    return interpolate(wavelengths_nm, nodes, values, where,
+                       "pure-water absorption (IOCCG 2018, Pope & Fry 1997 at 420-727.5 nm)")
 
 
 def scattering(wavelengths_nm: np.ndarray) -> np.ndarray:

@@ -10,9 +10,11 @@ from ..context import Ctx
 from .common import Case, _plt
 
 WL = np.array([412.0, 443.0, 490.0, 555.0, 670.0])
-# Pope & Fry (1997) a_w (1/m) as printed (OMLC table, 1/cm x 100) at 490 and 670 nm; at 412 nm
-# linearly between the printed 410 nm (0.00473) and 412.5 nm (0.00452)
-POPE_FRY = {412.0: 0.00473 + 0.8 * (0.00452 - 0.00473), 490.0: 0.0150, 670.0: 0.439}
+# pure-water a_w (1/m) as printed: Pope & Fry (1997) at 490 and 670 nm (OMLC table, 1/cm x 100);
+# at 412 nm, below the 420 nm where the IOCCG Protocols (2018)'s spectrum takes Pope & Fry up,
+# Morel et al. (2007) Table 2a, 0.0046 at both 410 and 415 nm
+PURE_WATER_A = {412.0: (0.0046, "Morel et al. 2007"), 490.0: (0.0150, "Pope & Fry 1997"),
+                670.0: (0.439, "Pope & Fry 1997")}
 
 
 def _config(components):
@@ -24,10 +26,9 @@ def _config(components):
 def case_constituent_iops(ctx: Ctx) -> None:
     from ... import optics
     (water,) = optics.column_iops(_config([{"model": "pure_water"}]))
-    for wl, a in POPE_FRY.items():
+    for wl, (a, source) in PURE_WATER_A.items():
         k = int(np.nonzero(WL == wl)[0][0])
-        ctx.exact(f"pure water: a_w({wl:g} nm) = {a} 1/m (Pope & Fry 1997)", water.a[k], a,
-                  rtol=1e-9)
+        ctx.exact(f"pure water: a_w({wl:g} nm) = {a} 1/m ({source})", water.a[k], a, rtol=1e-9)
     ctx.exact("pure water: b_w = 0.00288 (lambda/500)^-4.32 (Morel 1974)", water.b,
               0.00288 * (WL / 500.0) ** -4.32, rtol=1e-12)
     ctx.exact("pure water: bb_w / b_w = 1/2", water.bb / water.b, 0.5, rtol=1e-12)
@@ -80,12 +81,13 @@ def case_constituent_iops(ctx: Ctx) -> None:
                "with Case-1 chlorophyll (0.1, 1, 10 mg/m3) or CDOM, as oceanmc.optics makes them.")
     ctx.note("Each constituent model evaluated by oceanmc.optics at 412, 443, 490, 555 and "
              "670 nm against its published formula, recomputed here, and the printed table "
-             "values (Pope & Fry 1997 a_w; Bricaud et al. 1998 A_phi, E_phi at 490 nm). The "
-             "chlorophyll model's backscatter fraction is carried by Fournier-Forand phase "
-             "functions tabulated at 4 significant digits of bb/b.")
+             "values (Pope & Fry 1997 and Morel et al. 2007 a_w; Bricaud et al. 1998 A_phi, "
+             "E_phi at 490 nm). The chlorophyll model's backscatter fraction is carried by "
+             "Fournier-Forand phase functions tabulated at 4 significant digits of bb/b.")
 
 
 CASE = Case("constituent_iops", "IOPs of each constituent model against the published formulas",
             case_constituent_iops,
-            "pure water (Pope & Fry 1997, Morel 1974), chlorophyll (Bricaud et al. 1998, Morel & "
-            "Maritorena 2001, Morel et al. 2002), CDOM and particles at five wavelengths")
+            "pure water (Pope & Fry 1997, Morel et al. 2007, Morel 1974), chlorophyll "
+            "(Bricaud et al. 1998, Morel & Maritorena 2001, Morel et al. 2002), CDOM and "
+            "particles at five wavelengths")
