@@ -103,9 +103,15 @@ def _check_writable(path: Path, overwrite: bool, need_bytes: int = 0,
     folder = path.parent if str(path.parent) else Path(".")
     # (mkdir alone says "File exists" of a folder path through a file, and an unwritable
     # system folder such as /proc may answer "No such file or directory")
-    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
-    if existing is not None and not existing.is_dir():
-        raise UsageError(f"cannot write results to {path}: {existing} is a file, not a folder")
+    for above in (folder, *folder.parents):
+        if above.is_symlink() and not above.exists():   # (exists() follows the link)
+            raise UsageError(f"cannot write results to {path}: {above} is a broken symbolic "
+                             "link")
+        if above.exists():
+            if not above.is_dir():
+                raise UsageError(f"cannot write results to {path}: {above} is a file, not a "
+                                 "folder")
+            break
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -214,14 +220,17 @@ def cmd_run(args: argparse.Namespace) -> int:
     # and it packs the scenes while trace_batch compiles (run/compiling.py; packing first
     # compiled them here, 2-3 s of a cold start)
     _ready_or_exit(configs, loaded)
-    scenes = []
-    for path, out, config in zip(configs, outputs, loaded):
+    runs = []
+    for path, config in zip(configs, loaded):
         try:
             # reads its data files: every scene is checked before any runs
-            run = prepare(config)
+            runs.append(prepare(config))
         except ConfigError as exc:
             bad = config_error(path, exc)
-            continue
+    if bad:   # (before any results folder is made)
+        return bad
+    scenes = []
+    for path, out, run in zip(configs, outputs, runs):
         _check_writable(out, args.overwrite or (args.resume and out.exists()),
                         _file_size_estimate(run.config))
         previous = None
@@ -234,8 +243,6 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"oceanmc: --resume: no file at {out} to continue; running {path} from the "
                   "start", file=sys.stderr, flush=True)
         scenes.append((path, run, RunFile(out, previous, args.overwrite)))
-    if bad:
-        return bad
 
     stop = StopRequest()
     stop.install()

@@ -243,6 +243,26 @@ def test_unwritable_output_fails_before_running(tmp_path, scene_file):
     assert "photons/s" not in done.stdout
 
 
+def test_a_broken_link_in_the_output_path_is_named(tmp_path, scene_file):
+    (tmp_path / "gone").symlink_to(tmp_path / "nowhere")
+    done = oceanmc("run", scene_file, "-o", tmp_path / "gone" / "r.h5", cwd=tmp_path)
+    assert done.returncode == 2
+    assert f"{tmp_path / 'gone'} is a broken symbolic link" in done.stderr, done.stderr
+
+
+def test_a_scene_refused_by_its_packer_leaves_no_results_folder(tmp_path, scene_file,
+                                                                 small_scene):
+    # a wavelength outside the water's tables: refused when the scene is packed, after the
+    # good config beside it was read; the folder for their results is not made
+    bad = dict(small_scene, wavelengths_nm=[150.0])
+    bad["water"] = {"layers": [{"thickness_m": 10.0, "components": [{"model": "pure_water"}]}]}
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(bad))
+    done = oceanmc("run", scene_file, tmp_path / "bad.yaml", "-o", tmp_path / "out" / "",
+                   cwd=tmp_path)
+    assert done.returncode == 2 and "150 nm is outside" in done.stderr, done.stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_show_prints_the_summary(tmp_path, scene_file):
     assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0
     done = oceanmc("show", "r.h5", "--config", cwd=tmp_path)

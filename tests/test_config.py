@@ -156,6 +156,22 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
     (lambda s: s["illumination"].update(sky="harrison-coombes"),
      "config: illumination.sky = 'harrison-coombes': allowed: 'uniform', 'cardioidal', "
      "'overcast', 'harrison_coombes' or a mapping {map}"),
+    # a non-number where a number or another form is allowed: not the number's range alone
+    (lambda s: s["bottom"].update(reflectance="x"),
+     "config: bottom.reflectance = 'x': expected a number or a list or a mapping {file}"),
+    # a list of the list member's form but not of numbers: that member's own problem
+    (lambda s: s["tallies"].update(theta_edges_deg=["a"]),
+     "config: tallies.theta_edges_deg[0] = 'a': allowed: a finite number (and 1 more "
+     "problem)"),
+    # a key of another section: its path there
+    (lambda s: s.update(sun_zenith=30),
+     "config: sun_zenith: unknown key; did you mean illumination.sun_zenith_deg (not at this "
+     "level)?"),
+    # two keys without their units: one problem each, not two
+    (lambda s: s["illumination"].update(sun_position={"time": "2024-06-21T12:00:00Z",
+                                                      "latitude": 1, "longitude": 2}),
+     "config: illumination.sun_position.latitude: unknown key; did you mean latitude_deg? "
+     "(and 1 more problem)"),
 ])
 def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
         small_scene, change, message):

@@ -16,8 +16,9 @@ from conftest import REPO, SMALL_SCENE
 from oceanmc.cli import main
 from oceanmc.config.tallies import HYDROLIGHT_THETA_EDGES_DEG
 from oceanmc.plot import DPI, close
-from oceanmc.plot.results import (MAX_PROFILE_WAVELENGTHS, open_result, profiles_figure,
-                                  radiance_figure, rrs_figure, wavelength_indices)
+from oceanmc.plot.results import (MAX_PROFILE_WAVELENGTHS, kd_r_figure, open_result,
+                                  profiles_figure, radiance_figure, rrs_figure,
+                                  wavelength_indices)
 
 WAVELENGTHS = np.arange(400.0, 701.0, 10.0)
 SPECTRAL_DEPTHS = np.array([0.0, 2.0, 5.0])
@@ -123,6 +124,23 @@ def test_profiles_spectral_lines_per_wavelength(spectral_file):
     fig = profiles_figure(result, wavelength_indices(result, 550.0))
     assert [len(ax.containers) for ax in fig.axes] == [1, 1, 1]
     close(fig)
+
+
+def test_a_notebook_passes_the_path_and_takes_the_defaults(mono_file, spectral_file):
+    # as the README says: each figure function from a results file's path, with the profiles'
+    # wavelengths and the radiance's depth and wavelength chosen as `oceanmc plot` chooses them
+    spectral = open_result(spectral_file)
+    fig = profiles_figure(str(spectral_file))
+    assert [len(ax.containers) for ax in fig.axes] == [MAX_PROFILE_WAVELENGTHS] * 3
+    close(fig)
+    fig = radiance_figure(spectral_file)
+    assert fig.axes[0].get_title() == radiance_figure(spectral, 0, 15).axes[0].get_title()
+    close(fig)
+    for figure in (rrs_figure, kd_r_figure):
+        close(figure(spectral_file))
+    assert kd_r_figure(mono_file) is None   # (Kd, R against wavelength: a spectral file's)
+    close(rrs_figure(mono_file))
+    close(profiles_figure(mono_file))
 
 
 def test_profiles_monochromatic(mono_file):

@@ -25,6 +25,18 @@ WATER = ["Ed", "Eu", "Eod", "Eou", "Eo", "Lu", "radiance"]
 AIR = ["Ed", "Eu", "radiance", "Lw", "Lu", "Lw_nadir", "Rrs_nadir"]
 
 
+def test_a_name_not_held_says_the_nearest_and_the_repr_is_one_line(result):
+    with pytest.raises(KeyError, match="'Rrs_nadir'.*did you mean air/Rrs_nadir"):
+        result["Rrs_nadir"]
+    with pytest.raises(KeyError, match="'Edd'.*did you mean Ed"):
+        result.stderr("Edd")
+    with pytest.raises(KeyError, match="'nothing like it' in this result\"$"):   # (no hint)
+        result["nothing like it"]
+    # (the dataclass's repr printed every batch: 67,000 characters for a one-wavelength run)
+    text = repr(result)
+    assert "\n" not in text and len(text) < 300 and "quantities" in text, text
+
+
 def test_contract_names_with_stderr_units_and_descriptions(saved):
     with h5py.File(saved) as f:
         for name in WATER + [f"air/{n}" for n in AIR]:

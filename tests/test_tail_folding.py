@@ -3,6 +3,7 @@ for AVX-512 (kernel/compile.py KERNEL_TAIL_FOLDING, masked_vectors): AVX2's mask
 the photon loop slower. Compiled (not run) in a process of its own per target, as Numba sets
 its target machine once per process."""
 import os
+import platform
 import subprocess
 import sys
 import textwrap
@@ -42,6 +43,8 @@ def _compiled_for(cpu_name: str, features: str) -> list[str]:
     return done.stdout.split()
 
 
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"),
+                    reason="the targets compared are x86's (Haswell's AVX2, Skylake's AVX-512)")
 @pytest.mark.parametrize("cpu_name, features, folds", [("haswell", HASWELL, False),
                                                        ("skylake-avx512", SKYLAKE_AVX512, True)])
 def test_tail_folding_only_with_avx512(cpu_name, features, folds):

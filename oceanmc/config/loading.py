@@ -12,6 +12,7 @@ import stat
 import sys
 import textwrap
 import types
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
@@ -266,18 +267,47 @@ def _key_path(loc: tuple) -> str:
 
 # a key's unit, left out when a misspelt key is matched (`chl: 1` or `b488: 3e-4`: the quantity
 # without its unit is close to none of the keys with it)
-_UNIT_SUFFIX = re.compile(r"_(per_m|mg_m3|m_s|deg|nm|m)$")
+_UNIT_SUFFIX = re.compile(r"_(per_m|mg_m3|m_s|deg|nm|m|atm_cm|pa)$")
+
+
+def _closest(key: str, names) -> str | None:
+    """The name closest to `key` (by the whole name, or by the name without its unit), if one is
+    close."""
+    by_stem = {_UNIT_SUFFIX.sub("", name): name for name in sorted(names)}
+    by_stem.update({name: name for name in names})
+    close = difflib.get_close_matches(key, sorted(by_stem), n=1, cutoff=0.6)
+    return by_stem[close[0]] if close else None
+
+
+@lru_cache(maxsize=1)
+def _section_keys() -> dict[str, list[str]]:
+    """{key: the key paths where it stands} over the scene's sections, the mappings reached
+    through mappings alone from the top (illumination.sun_zenith_deg, tallies.depths_m; not
+    through a list such as water.layers)."""
+    found: dict[str, list[str]] = {}
+
+    def visit(loc: tuple) -> None:
+        for name in sorted(schema_keys(loc) or ()):
+            found.setdefault(name, []).append(".".join((*loc, name)))
+            if len(loc) < 3 and schema_keys((*loc, name)):
+                visit((*loc, name))
+    visit(())
+    return found
 
 
 def _suggestion(loc: tuple) -> str:
-    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close (by the
-    whole key, or by the key without its unit)."""
-    names = schema_keys(loc[:-1]) or set()
-    by_stem = {_UNIT_SUFFIX.sub("", name): name for name in sorted(names)}
-    by_stem.update({name: name for name in names})
-    close = difflib.get_close_matches(str(loc[-1]), sorted(by_stem), n=1, cutoff=0.6)
-    return f"; did you mean {by_stem[close[0]]}?" if close else \
-        " (check its spelling and level)"
+    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close; else
+    the path of a close key in another section (`sun_zenith` at the top: illumination's
+    sun_zenith_deg), where it stands in one only."""
+    key = str(loc[-1])
+    here = _closest(key, schema_keys(loc[:-1]) or set())
+    if here is not None:
+        return f"; did you mean {here}?"
+    elsewhere = _closest(key, _section_keys())
+    paths = _section_keys().get(elsewhere, []) if elsewhere is not None else []
+    if len(paths) == 1:
+        return f"; did you mean {paths[0]} (not at this level)?"
+    return " (check its spelling and level)"
 
 
 def schema_keys(loc: tuple) -> set[str] | None:
@@ -374,10 +404,18 @@ def _describe(error: dict) -> str:
         return f"{path}.{key}: required key is missing"
     if path == "(top level)" and kind == "value_error":
         return msg
-    allowed = _allowed_range(error) or (_union_forms(tuple(error.get("loc", ())))
-                                         if kind in _WRONG_FORM else "")
-    if allowed:
-        msg = f"allowed: {allowed}"
+    loc = tuple(error.get("loc", ()))
+    forms = _union_forms(loc)
+    if kind in _NOT_A_NUMBER and forms:
+        # one member of a union that also takes a list, a file or a profile: its range alone
+        # would read as all that is allowed (and a validator may bound it further, chl_mg_m3's
+        # 100 mg/m3)
+        msg = f"expected a number or {' or '.join(forms)}"
+    else:
+        allowed = _allowed_range(error) or (" or ".join(forms) if kind in _WRONG_FORM
+                                            and len(forms) > 1 else "")
+        if allowed:
+            msg = f"allowed: {allowed}"
     if "input" in error and not isinstance(error["input"], dict):
         shown = _shown(error["input"])
         if len(shown) > 80:
@@ -414,13 +452,13 @@ _WRONG_FORM = frozenset({"list_type", "tuple_type", "literal_error", "dict_type"
                          "model_attributes_type"})
 
 
-def _union_forms(loc: tuple) -> str:
-    """For a value of the wrong form where a union chooses its member by the value's form (a
-    list or {start, stop, step} for wavelengths_nm; a sky's name or {map: FILE}): every form
-    the key allows, in words (pydantic names only those of the member it tried); '' for
-    another error."""
+def _union_forms(loc: tuple) -> list[str]:
+    """For an error at a member of a union that chooses its member by the value's form (a list
+    or {start, stop, step} for wavelengths_nm; a sky's name or {map: FILE}): the forms other
+    than a number the key allows, in words (pydantic names only those of the member it
+    tried); [] where the error is not at a union's member."""
     if not (loc and _is_branch_tag(loc[-1])):
-        return ""
+        return []
     forms = []
     for annotation in _annotations_at(loc[:-1]) or []:
         for member, _ in _alternatives(annotation):
@@ -432,7 +470,7 @@ def _union_forms(loc: tuple) -> str:
             elif isinstance(bare, type) and issubclass(bare, BaseModel):
                 keys = [name for name, field in bare.model_fields.items() if field.is_required()]
                 forms.append(f"a mapping {{{', '.join(keys)}}}")
-    return " or ".join(forms) if len(forms) > 1 else ""
+    return forms
 
 
 def _first_problem(errors: list[dict]) -> tuple[str, int]:
@@ -446,14 +484,29 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
 
     first = errors[0]
     if first.get("type") == "missing":
-        for error in errors:
-            suggested = _suggestion(tuple(error.get("loc", ())))
-            if error.get("type") == "extra_forbidden" and parent(error) == parent(first) \
-                    and suggested.startswith("; did you mean"):
-                # (the missing key, when it is the one suggested, is the same problem)
-                missing = str(first["loc"][-1]) if first.get("loc") else ""
-                return _describe(error), 2 if suggested == f"; did you mean {missing}?" else 1
+        missing = {str(e["loc"][-1]) for e in errors if e.get("type") == "missing"
+                   and e.get("loc") and parent(e) == parent(first)}
+        unknown = [e for e in errors
+                   if e.get("type") == "extra_forbidden" and parent(e) == parent(first)]
+        suggested = {id(e): _suggestion(tuple(e.get("loc", ())))[len("; did you mean "):-1]
+                     for e in unknown
+                     if _suggestion(tuple(e.get("loc", ()))).startswith("; did you mean")}
+        named = [e for e in unknown if id(e) in suggested]
+        if named:
+            # an unknown key that names a missing one (`latitude` for latitude_deg) and that
+            # missing key are one problem: the count of the others says so too
+            pairs = sum(suggested[id(e)] in missing for e in named)
+            return _describe(named[0]), 1 + pairs
     loc = tuple(first.get("loc", ()))
+    if loc and _is_branch_tag(loc[-1]) and first.get("type") in _WRONG_FORM:
+        # a value of one member's form that the member refused (theta_edges_deg: ['a'], a
+        # list, but not of numbers): that member's error, not the other's "wrong form"
+        path = _key_path(loc)
+        for error in errors[1:]:
+            deeper = tuple(error.get("loc", ()))
+            if _key_path(deeper).startswith(path) and not (
+                    _is_branch_tag(deeper[-1]) and error.get("type") in _WRONG_FORM):
+                return _describe(error), 1
     # (a member that is a model reports its own keys after the tag: described as they are)
     if not (loc and _is_branch_tag(loc[-1])) or isinstance(first.get("input"), dict):
         return _describe(first), 1

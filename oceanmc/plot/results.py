@@ -152,10 +152,17 @@ def _wavelength_label(result: ResultFile, index: int | None) -> str:
 
 # --- the figures -------------------------------------------------------------------------------
 
-def rrs_figure(result: ResultFile):
+def opened(result: ResultFile | str | Path) -> ResultFile:
+    """A results file's path opened (open_result), for the figure functions below, which a
+    notebook calls with a path."""
+    return open_result(result) if isinstance(result, (str, Path)) else result
+
+
+def rrs_figure(result: ResultFile | str | Path):
     """air/Rrs_nadir against wavelength, shaded +- one standard error; one marker with its error
     bar for a monochromatic file. With inelastic light, its parts beside it (rrs_parts). None
     where the file has no Rrs_nadir."""
+    result = opened(result)
     if "Rrs_nadir" not in result.air:
         return None
     rrs = result.air["Rrs_nadir"]
@@ -233,11 +240,15 @@ PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward pla
                       ("Eo", "scalar irradiance Eo"))
 
 
-def kd_r_figure(result: ResultFile):
+def kd_r_figure(result: ResultFile | str | Path):
     """Kd (one line per interval between adjacent tally depths) and R = Eu/Ed (one line per
     tally depth) against wavelength, at most MAX_DERIVED_LINES of each, shaded +- one standard
-    error (the jackknife over batches of run/derived.py)."""
+    error (the jackknife over batches of run/derived.py). None for a monochromatic file or one
+    without derived quantities."""
+    result = opened(result)
     derived, grid = result.derived, result.wavelengths
+    if grid is None or derived is None or "Kd" not in derived:
+        return None
     fig, axes = panels(2, 2, (4.8, 4.0))
     for ax, name, dim, title in ((axes[0], "Kd", "depth_interval",
                                   "diffuse attenuation of Ed, Kd"),
@@ -267,9 +278,13 @@ def kd_r_figure(result: ResultFile):
     return fig
 
 
-def profiles_figure(result: ResultFile, indices: list[int]):
+def profiles_figure(result: ResultFile | str | Path, indices: list[int] | None = None):
     """Ed, Eu and Eo against depth (one panel each), one line per wavelength index (indices []:
-    monochromatic), irradiance on a log axis, error bars of one standard error."""
+    monochromatic; None: up to MAX_PROFILE_WAVELENGTHS spread over a spectral file's),
+    irradiance on a log axis, error bars of one standard error."""
+    result = opened(result)
+    if indices is None:
+        indices = wavelength_indices(result, None)
     fig, axes = panels(len(PROFILE_QUANTITIES), 3, (4.2, 4.6))
     lines = indices or [None]
     colours = _wavelength_colours(result, lines)
@@ -316,10 +331,15 @@ def _hemispheres(theta_edges: np.ndarray, values: np.ndarray):
             ("upwelling (radius: nadir angle looked at)",) + up)
 
 
-def radiance_figure(result: ResultFile, depth: int, wavelength: int | None):
-    """The radiance on the polar quads at one tallied depth (top row) and at 0+ (bottom row),
-    downwelling and upwelling hemispheres side by side, each on its own logarithmic colour scale.
-    None where the file has no radiance."""
+def radiance_figure(result: ResultFile | str | Path, depth: int = 0,
+                    wavelength: int | None = None):
+    """The radiance on the polar quads at the tallied depth of index `depth` (top row) and at 0+
+    (bottom row), downwelling and upwelling hemispheres side by side, each on its own
+    logarithmic colour scale, at the wavelength of index `wavelength` (None: a spectral file's
+    middle one). None where the file has no radiance."""
+    result = opened(result)
+    if wavelength is None and result.wavelengths is not None:
+        wavelength = len(result.wavelengths) // 2
     if "radiance" not in result.water:
         return None
     theta_edges = np.asarray(result.water.coords["theta_edges"], dtype=np.float64)

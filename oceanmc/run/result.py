@@ -6,6 +6,7 @@ batch values are stored, results of independent runs merge by concatenating batc
 """
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,13 +58,33 @@ class Result:
     iops: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
-        return self.quantities[name].mean
+        return self._quantity(name).mean
 
     def __contains__(self, name: str) -> bool:
         return name in self.quantities
 
     def stderr(self, name: str) -> np.ndarray:
-        return self.quantities[name].stderr
+        return self._quantity(name).stderr
+
+    def _quantity(self, name: str) -> Quantity:
+        """The quantity, or a KeyError naming the nearest names (`Rrs_nadir` is
+        `air/Rrs_nadir`)."""
+        if name in self.quantities:
+            return self.quantities[name]
+        leaf = str(name).rpartition("/")[2]
+        near = [q for q in self.quantities if q.rpartition("/")[2] == leaf] or \
+            difflib.get_close_matches(str(name), list(self.quantities), n=3, cutoff=0.6)
+        hint = f"; did you mean {' or '.join(near)}?" if near else ""
+        raise KeyError(f"no quantity {name!r} in this result{hint}")
+
+    def __repr__(self) -> str:
+        # (the dataclass's own repr printed every batch of every quantity: 67,000 characters
+        # for a one-wavelength run)
+        sizes = ", ".join(f"{k} {len(v)}" for k, v in self.coords.items()
+                          if k in ("wavelength", "depth", "direction") and len(v))
+        return (f"<oceanmc Result {self.attrs.get('name', '')!r}: {len(self.quantities)} "
+                f"quantities ({sizes}), {self.attrs.get('batches', '?')} batches, "
+                f"{self.attrs.get('photons', '?')} photons>")
 
     @property
     def config_yaml(self) -> str:
