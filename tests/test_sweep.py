@@ -18,6 +18,7 @@ import yaml
 
 import oceanmc
 from conftest import REPO
+from oceanmc.run.derived import derive
 from oceanmc.sweeps import SweepError, load_sweep, set_key_path
 from oceanmc.sweeps.dataset import variable_name
 from oceanmc.sweeps.points import build_points
@@ -59,11 +60,16 @@ def assert_points_match_single_runs(ds, spec_source, only_done=False):
             assert only_done, point.label
             continue
         single = oceanmc.simulate(point.config, threads=1)
-        for name, q in single.quantities.items():
+        # every quantity, and the derived ones (Kd, R, Q, ...: the results file's group
+        # `derived`) as derived_NAME
+        pairs = [(name, q.mean, q.stderr) for name, q in single.quantities.items()] + \
+            [(f"derived/{d.name}", d.value, d.stderr) for d in derive(single).values()]
+        assert any(name == "derived/Kd" for name, _, _ in pairs)
+        for name, mean, stderr in pairs:
             var = variable_name(name)
-            assert np.array_equal(ds[var].values[point.index], q.mean, equal_nan=True), \
+            assert np.array_equal(ds[var].values[point.index], mean, equal_nan=True), \
                 (point.label, name)
-            assert np.array_equal(ds[var + "_stderr"].values[point.index], q.stderr,
+            assert np.array_equal(ds[var + "_stderr"].values[point.index], stderr,
                                   equal_nan=True), (point.label, name)
         checked += 1
     return checked
@@ -376,6 +382,9 @@ def test_local_cluster_two_processes_points_bit_identical_batch_groups_and_rerun
     xr.testing.assert_identical(stored.load(), ds)
     # batches spread over two tasks per point, merged: the same numbers as one run
     assert assert_points_match_single_runs(ds, path) == 4
+    # the K functions along the interval between the tally depths, which it names
+    assert ds["derived_Kd"].dims[-1] == "depth_interval"
+    assert list(ds["depth_upper"].values) == [0.0] and list(ds["depth_lower"].values) == [1.0]
     # more photons per point beside the reflectance axis: the finished points are skipped
     spec = yaml.safe_load(path.read_text())
     spec["axes"]["water.layers[0].a"].append(0.4)

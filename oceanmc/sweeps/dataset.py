@@ -6,7 +6,8 @@ Dataset layout: one dimension per axis (named by its key path, or by its short n
 keys of a zip group are coordinates along it), then each quantity's own dimensions
 (wavelength, depth, theta, phi, and direction when the scene has local_directions_deg);
 every quantity X of the results file (`air/Rrs_nadir` becomes `air_Rrs_nadir`, `budget/total`
-`budget_total`) with `X_stderr` beside it; per point `status` (done, failed, pending), `error`,
+`budget_total`, the derived `Kd` `derived_Kd`, along depth_interval with depth_upper and
+depth_lower) with `X_stderr` beside it; per point `status` (done, failed, pending), `error`,
 `photons` and `wall_time_s`; the base scene and the sweep in the attributes."""
 from __future__ import annotations
 
@@ -17,6 +18,8 @@ import numpy as np
 import yaml
 
 from .. import __version__
+from ..run.derived import COORDS as DERIVED_COORDS
+from ..run.derived import derive, intervals
 from ..run.format import COORD_UNITS, SWEEP_TITLE
 from ..run.hdf5 import load_result
 from ..run.merge import merge_results, scene_difference
@@ -44,9 +47,17 @@ class Summary:
 
     @classmethod
     def of(cls, result: Result) -> "Summary":
-        return cls({name: (q.dims, q.mean, q.stderr, q.units, q.description)
-                    for name, q in result.quantities.items()},
-                   dict(result.coords), int(result.attrs["photons"]),
+        """The result's quantities, and its derived ones (K functions, R, Q, mean cosines: the
+        results file's group `derived`) as `derived/NAME`."""
+        quantities = {name: (q.dims, q.mean, q.stderr, q.units, q.description)
+                      for name, q in result.quantities.items()}
+        coords = dict(result.coords)
+        for d in derive(result).values():
+            quantities[f"derived/{d.name}"] = (d.dims, d.value, d.stderr, d.units,
+                                               d.description)
+            if "depth_interval" in d.dims and "depth_interval" not in coords:
+                coords.update(intervals(result.coords["depth"]))
+        return cls(quantities, coords, int(result.attrs["photons"]),
                    float(result.attrs["wall_time_s"]))
 
 
@@ -139,6 +150,8 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
                 continue
             if name in ("direction_theta", "direction_phi"):
                 coords[name] = ("direction", values, _coord_attrs(name))
+            elif name in ("depth_upper", "depth_lower"):
+                coords[name] = ("depth_interval", values, _coord_attrs(name))
             elif name not in coords:
                 coords[name] = (name, values, _coord_attrs(name))
     arrays: dict[str, tuple] = {}
@@ -184,7 +197,7 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
 
 
 def _coord_attrs(name: str) -> dict:
-    units, description = COORD_UNITS[name]
+    units, description = COORD_UNITS[name] if name in COORD_UNITS else DERIVED_COORDS[name]
     return {"units": units, "description": description}
 
 
