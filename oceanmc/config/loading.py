@@ -488,9 +488,9 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
                    and e.get("loc") and parent(e) == parent(first)}
         unknown = [e for e in errors
                    if e.get("type") == "extra_forbidden" and parent(e) == parent(first)]
-        suggested = {id(e): _suggestion(tuple(e.get("loc", ())))[len("; did you mean "):-1]
-                     for e in unknown
-                     if _suggestion(tuple(e.get("loc", ()))).startswith("; did you mean")}
+        hints = {id(e): _suggestion(tuple(e.get("loc", ()))) for e in unknown}
+        suggested = {key: hint[len("; did you mean "):-1] for key, hint in hints.items()
+                     if hint.startswith("; did you mean")}
         named = [e for e in unknown if id(e) in suggested]
         if named:
             # an unknown key that names a missing one (`latitude` for latitude_deg) and that
