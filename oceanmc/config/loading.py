@@ -366,11 +366,14 @@ def _annotations_at(loc: tuple) -> list[Any] | None:
 
 
 def _shown(value: Any) -> str:
-    """repr(value), except for a time (YAML reads an unquoted one as a datetime: shown as
-    written, ISO 8601) and an integer too long for repr (more than 4300 digits: a
+    """repr(value), except for a time, alone or in a list (YAML reads an unquoted one as a
+    datetime: shown in ISO 8601, as written) and an integer too long for repr (more than 4300 digits: a
     ValueError)."""
     if isinstance(value, (datetime.date, datetime.time)):
         return value.isoformat()
+    if isinstance(value, list) and any(isinstance(v, (datetime.date, datetime.time))
+                                       for v in value):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
     try:
         return repr(value)
     except ValueError:
