@@ -263,6 +263,17 @@ def test_a_scene_refused_by_its_packer_leaves_no_results_folder(tmp_path, scene_
     assert not (tmp_path / "out").exists()
 
 
+def test_a_missing_table_file_is_named_with_its_key(tmp_path, small_scene):
+    # (the table's own check names the file; the key says which of the scene's tables it is)
+    small_scene["water"]["layers"][0]["phase"] = {"model": "table", "file": "nope.csv"}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", tmp_path / "s.yaml", "-o", "r.h5", cwd=tmp_path)
+    assert done.returncode == 2
+    assert f"water.layers[0].phase.file: phase table {tmp_path / 'nope.csv'}: no such file" \
+        in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and not (tmp_path / "r.h5").exists()
+
+
 def test_show_prints_the_summary(tmp_path, scene_file):
     assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0
     done = oceanmc("show", "r.h5", "--config", cwd=tmp_path)

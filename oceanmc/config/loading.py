@@ -367,8 +367,8 @@ def _annotations_at(loc: tuple) -> list[Any] | None:
 
 def _shown(value: Any) -> str:
     """repr(value), except for a time, alone or in a list (YAML reads an unquoted one as a
-    datetime: shown in ISO 8601, as written) and an integer too long for repr (more than 4300 digits: a
-    ValueError)."""
+    datetime: shown in ISO 8601, as written) and an integer too long for repr (more than 4300
+    digits: a ValueError)."""
     if isinstance(value, (datetime.date, datetime.time)):
         return value.isoformat()
     if isinstance(value, list) and any(isinstance(v, (datetime.date, datetime.time))
@@ -637,6 +637,23 @@ def data_file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
     if isinstance(config.illumination.sky, SkyMap):
         fields.append((config.illumination.sky, "map", "illumination.sky.map"))
     return fields
+
+
+def file_keys(problem: str, config: SceneConfig) -> list[str]:
+    """The key paths of the scene's data files a problem of building it is about: the file its
+    message names (`BRDF table PATH: no such file`, `KEY.file: PATH: ...`)."""
+    return [key for model, attribute, key in data_file_fields(config)
+            if f"{getattr(model, attribute)}:" in problem]
+
+
+def at_file_key(problem: str, config: SceneConfig) -> str:
+    """A problem of a data file (`phase table PATH: no such file`) under the key that names the
+    file (`water.layers[0].phase.file: phase table PATH: ...`), so that a scene with several
+    tables says which; as it is where it names no file or starts with the key already."""
+    keys = file_keys(problem, config)
+    if keys and not any(problem.startswith(key) for key in keys):
+        return f"{keys[0]}: {problem}"
+    return problem
 
 
 def _resolve_files(config: SceneConfig, base_dir: Path, origin: str) -> None:

@@ -28,6 +28,7 @@ from tqdm import tqdm
 from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
+from ..config.loading import at_file_key
 from ..kernel.records import PACKET, packet_state_size, work_size
 from ..kernel.rng import STATE_WORDS, batch_state
 from ..scene.grid import tally_arrays, tally_views, write_tally_arrays
@@ -139,7 +140,10 @@ def prepare(config: SceneConfig) -> PreparedRun:
     ConfigError (one line) for unusable auxiliary files or tallies too large for memory."""
     data_hashes = data_file_hashes(config)   # before the build reads them
     ed0, diffuse, _ = illumination_spectrum(config)
-    sc = scene.build(config, (ed0, diffuse))
+    try:
+        sc = scene.build(config, (ed0, diffuse))
+    except ConfigError as exc:   # (a table's own checks name the file: the key named too)
+        raise type(exc)(at_file_key(str(exc), config)) from None
     check_tally_memory(config, sc)
     return PreparedRun(config, sc, RunFacts.of(config, sc, ed0, diffuse),
                        config_to_yaml(config, (ed0, diffuse)), data_hashes)

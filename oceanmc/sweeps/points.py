@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass
 
 from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
-from ..config.loading import DISCRIMINATORS, data_file_fields
+from ..config.loading import DISCRIMINATORS, file_keys
 from .axes import SweepError, SweepSpec, parse_key_path
 
 
@@ -114,7 +114,7 @@ def check_scenes(points: list[Point], spec: SweepSpec | None = None) -> None:
             scene.build(point.config)
         except ConfigError as exc:
             text = _without_origin(exc)
-            keys = _file_keys(text, point.config)
+            keys = file_keys(text, point.config)
             # (`KEY:`: a file's key path is a problem at that key)
             if spec is not None and keys and all(
                     _set_by(f"{key}:", spec.settings)
@@ -127,13 +127,6 @@ def check_scenes(points: list[Point], spec: SweepSpec | None = None) -> None:
         raise SweepError(f"set: {from_set[0]}")   # every point: the set's file alone
     if bad:
         _raise_first(bad)
-
-
-def _file_keys(problem: str, config: SceneConfig) -> list[str]:
-    """The key paths of the scene's data files a problem of building it is about: the file its
-    message names (`BRDF table PATH: no such file`, `KEY.file: PATH: ...`)."""
-    return [key for model, attribute, key in data_file_fields(config)
-            if f"{getattr(model, attribute)}:" in problem]
 
 
 def _set_by(problem: str, values: dict) -> bool:
