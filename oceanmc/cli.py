@@ -581,7 +581,8 @@ def build_parser() -> argparse.ArgumentParser:
                                        "and radiance distribution to PNG")
     plot.add_argument("file", metavar="RESULT.h5")
     plot.add_argument("-o", "--output", metavar="DIR|PREFIX",
-                      help="folder, or file prefix for _rrs.png, _profiles.png, _radiance.png "
+                      help="folder, or file prefix for _rrs.png, _profiles.png, _radiance.png, "
+                           "_kd_r.png "
                            "(default: RESULT without .h5)")
     plot.add_argument("--depth", type=float, metavar="Z",
                       help="tallied depth (m) of the radiance plot (default: 0, just below)")

@@ -164,6 +164,10 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
      "config: tallies.theta_edges_deg[0] = 'a': allowed: a finite number (and 1 more "
      "problem)"),
     # a key of another section: its path there
+    # a boolean for a string: what the key takes, not "a number"
+    (lambda s: s.update(name=False),
+     "config: name = False: expected a string (YAML reads true, false, yes, no, on and off as "
+     "booleans)"),
     (lambda s: s.update(sun_zenith=30),
      "config: sun_zenith: unknown key; did you mean illumination.sun_zenith_deg (not at this "
      "level)?"),

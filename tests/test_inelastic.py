@@ -34,6 +34,7 @@ from oceanmc.optics.illumination import illumination_spectrum
 from oceanmc.optics.inelastic import channels, factors, transfer
 from oceanmc.optics.inelastic import chlorophyll_fluorescence as fluorescence
 from oceanmc.optics.inelastic import raman
+from oceanmc.run.simulation import prepare
 from oceanmc.validation.cases.inelastic import clear_water
 
 from inelastic_helpers import (assert_budgets_close, assert_estimates_agree, hat_integral,
@@ -556,6 +557,9 @@ def test_hdf5_round_trip_keeps_parts(whole, tmp_path):
     ({"chlorophyll_fluorescence": {"quantum_yield": 1.5}},
      ["water.inelastic.chlorophyll_fluorescence.quantum_yield"]),
     ({"raman": {}, "max_step_nm": 0}, ["water.inelastic.max_step_nm"]),
+    # no process named: the scene would have run elastic, saying nothing
+    ({}, ["water.inelastic: no process named", "raman", "leave water.inelastic out"]),
+    ({"max_step_nm": 5}, ["water.inelastic: no process named"]),
 ])
 def test_bad_values_are_refused_with_one_clear_line(inelastic, needles):
     with pytest.raises(ConfigError) as info:
@@ -564,6 +568,19 @@ def test_bad_values_are_refused_with_one_clear_line(inelastic, needles):
     assert "\n" not in message.strip(), message
     for needle in needles:
         assert needle in message, (needle, message)
+
+
+def test_a_traced_wavelength_outside_the_spectrum_is_said_to_be_added():
+    # 300 nm is within SPECTRL2's table; Raman light there is excited at 260-290 nm, which the
+    # run adds: the message says so, not only "260 nm is outside"
+    config = scene({"raman": {}})
+    config["wavelengths_nm"] = [300.0]
+    config["illumination"] = {"spectrum": {"model": "spectrl2"}}
+    with pytest.raises(ConfigError) as info:
+        prepare(oceanmc.load_config(config))
+    message = str(info.value)
+    assert "wavelength 260 nm is outside the SPECTRL2" in message, message
+    assert "(traced for the excitation of water.inelastic, which adds 260-290 nm;" in message
 
 
 # --- the Fraunhofer lines (validation case fraunhofer, Ge, Gordon & Voss 1993) -------------------

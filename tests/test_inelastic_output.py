@@ -70,8 +70,12 @@ def test_summary_names_the_processes_and_the_added_wavelengths(inelastic_run):
     printed, _ = inelastic_run
     flat = " ".join(printed.split())
     assert "inelastic light: Raman scattering by water (b_R 0.00026 1/m at 488 nm, as " \
-        "(488/l)^5.5), chlorophyll fluorescence (quantum yield 0.02, 685 nm" in flat
+        "(488/l)^5.5; phase function 1 + 0.55 cos^2), chlorophyll fluorescence (quantum " \
+        "yield 0.02, 685 nm" in flat
     assert "elastic/, raman/, chlorophyll_fluorescence/" in flat
+    # (a user comparing elastic/ with a code without inelastic light is told it differs)
+    assert "elastic/ is the light no process shifted, after their losses (not a run without " \
+        "them)" in flat
     assert "traced also 340-390 nm (10 nm steps) for the excitation of inelastic light; " \
         "reported with the rest, though those below 400 nm lack the inelastic light excited " \
         "below 340 nm" in flat

@@ -164,6 +164,16 @@ def test_monochromatic_summary_names_estimators_and_local_directions(small_scene
     assert "Rrs nadir (crossing)" in labels and "Lu(1 m) (crossing)" in labels
 
 
+def test_one_wavelength_with_its_excitation_says_the_table_holds_more():
+    # Raman light at 550 nm is excited at 450-540 nm, which the run traces and prints too
+    config = dict(SPECTRAL, wavelengths_nm=[550], photons=400)
+    config["water"] = dict(SPECTRAL["water"], inelastic={"raman": {}})
+    text = " ".join(format_summary(oceanmc.simulate(config, threads=1)).split())
+    assert "asked for 550 nm alone; the table holds the wavelengths traced for its " \
+        "excitation as well" in text
+    assert "the scene's one wavelength" not in text
+
+
 def test_a_run_at_one_wavelength_says_which():
     """A file of one wavelength has no wavelength coordinate: the summary names it, and says
     nothing of the kind for a monochromatic scene or a spectrum."""

@@ -35,15 +35,17 @@ def _admits_boolean(annotation: Any) -> bool:
 
 
 def _expected(annotation: Any) -> str:
-    """What a field takes, in words, for a message: a mapping (a group of keys), a list, or a
-    number (or several of them, for a union)."""
+    """What a field takes, in words, for a message: a mapping (a group of keys), a list, a
+    string or a number (or several of them, for a union)."""
     def kind(member: Any) -> str:
         if isinstance(member, type) and issubclass(member, BaseModel):
             return "a mapping"
+        if member is str:
+            return "a string"   # (`name: off`: not a number)
         return "a list" if typing.get_origin(member) in (list, tuple) else "a number"
 
     given = {kind(m) for m in _members(annotation) if m is not type(None)} or {"a number"}
-    kinds = [k for k in ("a number", "a list", "a mapping") if k in given]
+    kinds = [k for k in ("a number", "a string", "a list", "a mapping") if k in given]
     return " or ".join([", ".join(kinds[:-1]), kinds[-1]]) if len(kinds) > 1 else kinds[0]
 
 

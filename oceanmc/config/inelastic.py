@@ -125,6 +125,11 @@ class Inelastic(_Strict):
         # while the user asked for it: refused; the stored config leaves out the processes that
         # are off (_without_processes_off), so it never writes a null here
         if isinstance(data, dict):
+            if not any(name in data for name in PROCESSES):
+                # (`inelastic: {}` would run the scene elastic, silently)
+                raise ValueError(f"no process named: give one or more of {', '.join(PROCESSES)} "
+                                 "({} for a process's published defaults), or leave "
+                                 "water.inelastic out")
             for name in PROCESSES:
                 if name in data and data[name] is None:
                     raise ValueError(f"{name} = null (nothing after '{name}:'): give {{}} for "

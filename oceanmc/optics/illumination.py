@@ -54,15 +54,25 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
     if np.isnan(wl).any():
         raise ConfigError(f"illumination.spectrum.model = {spectrum.model!r} needs "
                           "wavelengths_nm")
-    if spectrum.model == "spectrl2":
-        day = spectrum.day_of_year or (light.sun_position.time.timetuple().tm_yday
-                                       if light.sun_position else MEAN_DISTANCE_DAY)
-        ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
-    else:
-        where = "illumination.spectrum.file"
-        table = read_table(spectrum.file, where, TABLE_COLUMNS)
-        ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where, spectrum.file)
-                        for name in ("Ed0", "diffuse_fraction"))
+    try:
+        if spectrum.model == "spectrl2":
+            day = spectrum.day_of_year or (light.sun_position.time.timetuple().tm_yday
+                                           if light.sun_position else MEAN_DISTANCE_DAY)
+            ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
+        else:
+            where = "illumination.spectrum.file"
+            table = read_table(spectrum.file, where, TABLE_COLUMNS)
+            ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where,
+                                        spectrum.file) for name in ("Ed0", "diffuse_fraction"))
+    except ConfigError as exc:
+        added = config.added_wavelengths
+        if added and any(f"wavelength {w:g} nm is outside" in str(exc) for w in added):
+            # (a wavelength the user never asked for: say where it came from)
+            raise ConfigError(f"{exc} (traced for the excitation of water.inelastic, which "
+                              f"adds {min(added):g}-{max(added):g} nm; ask for longer "
+                              "wavelengths, or give a spectrum table that covers these)") \
+                from None
+        raise
     if np.any(ed0 <= 0.0):
         raise ConfigError(f"illumination.spectrum: Ed0 = 0 at {wl[ed0 <= 0.0][0]:g} nm; every "
                           "wavelength needs light")

@@ -203,7 +203,8 @@ def process_descriptions(result: Result) -> list[str]:
     for name, process in inelastic.processes():
         if name == "raman":
             said.append(f"Raman scattering by water (b_R {process.b488_per_m:g} 1/m at 488 nm, "
-                        f"as (488/l)^{process.exponent:g})")
+                        f"as (488/l)^{process.exponent:g}; phase function 1 + "
+                        f"{process.phase_beta:g} cos^2)")
         elif name == "chlorophyll_fluorescence":
             low, high = process.excitation_range_nm
             said.append(f"chlorophyll fluorescence (quantum yield {process.quantum_yield:g}, "
@@ -228,7 +229,8 @@ def inelastic_lines(result: Result) -> list[str]:
         return []
     said = [f"inelastic light: {', '.join(process_descriptions(result))}; every quantity but "
             "the ratios is also split into parts that add up to it: "
-            f"{', '.join(p + '/' for p in parts)} (e.g. {parts[1]}/air/Rrs_nadir)"]
+            f"{', '.join(p + '/' for p in parts)} (e.g. {parts[1]}/air/Rrs_nadir); elastic/ "
+            "is the light no process shifted, after their losses (not a run without them)"]
     if "wavelengths_added_nm" in result.attrs:
         added = np.atleast_1d(np.asarray(result.attrs["wavelengths_added_nm"], dtype=float))
         wavelengths = result.coords["wavelength"]
@@ -368,7 +370,10 @@ def format_summary(result: Result) -> str:
         f"(start-up {a['startup_time_s']:.2f} s)",
     ]
     at = single_wavelength(result)
-    if at is not None:
+    if at is not None and "wavelength" in result.coords:   # (and those its excitation needs)
+        lines.append(f"  asked for {at:g} nm alone; the table holds the wavelengths traced for "
+                     "its excitation as well")
+    elif at is not None:
         lines.append(f"  at {at:g} nm (the scene's one wavelength)")
     said = completeness_line(result)
     if said is not None:
