@@ -138,7 +138,18 @@ def test_per_wavelength_list_needing_extension_is_refused(where):
     assert "water.inelastic.raman" in message, message
     assert "340, 350, 360, 370, 380, 390 nm" in message, message
     assert key in message, message
-    assert f"{len(values)} values" in message, message
+    # (the user's own count of wavelengths, not the traced grid's)
+    assert f"hold values for its {len(values)} wavelengths only" in message, message
+
+
+def test_every_per_wavelength_list_needing_extension_is_named():
+    config = scene({"raman": {}})
+    values = [0.01] * len(REQUESTED)
+    config["water"]["layers"] = [{"thickness_m": 5.0, "a": values, "b": 0.1}]
+    config["bottom"] = {"model": "lambertian", "reflectance": [0.2] * len(REQUESTED)}
+    with pytest.raises(ConfigError, match=r"water\.layers\[0\]\.a, bottom\.reflectance hold "
+                                          r"values for its 31 wavelengths only"):
+        oceanmc.load_config(config)
 
 
 def test_inelastic_without_wavelengths_is_refused():

@@ -11,7 +11,7 @@ from pydantic import Field, PrivateAttr, field_validator, model_validator
 from .base import (_Strict, allowed_numbers, non_finite_text, shown_value_error,
                    too_long_integer)
 from .bottom import (Bottom, bottom_has_mirror, bottom_weight_bounded,
-                     check_bottom_wavelengths)
+                     check_bottom_wavelengths, reflectance_keys)
 from .estimator import AUTO_UPWARD_FRACTION, Estimator
 from .illumination import Illumination
 from .inelastic import transport_grid
@@ -219,14 +219,16 @@ class SceneConfig(_Strict):
         if len(traced) == len(requested):
             return
         added = [float(w) for w in traced if not np.isclose(requested, w).any()]
-        try:
-            self.water.check_wavelength_count(len(traced), True)
-            check_bottom_wavelengths(self.bottom, len(traced), True)
-        except ValueError as exc:
+        # (their counts were checked against the requested grid: every list is one too short)
+        lists = [key for key, value in (*self.water.spectral_values(),
+                                        *reflectance_keys(self.bottom))
+                 if isinstance(value, list)]
+        if lists:
             raise ValueError(
                 f"{names} needs the light of {_listed(added)} nm, which wavelengths_nm "
-                f"lacks; add them to wavelengths_nm and give the per-wavelength lists values "
-                f"there ({exc})") from None
+                f"lacks, and {', '.join(lists)} hold values for its {len(requested)} "
+                "wavelengths only: add those to wavelengths_nm and give the lists values "
+                "there, or give each one number")
         self._traced = [float(w) for w in traced]
 
     @property

@@ -97,13 +97,20 @@ class Water(_Strict):
             if layer.components is not None and not spectral:
                 raise ValueError(f"water.layers[{i}].components: constituents need "
                                  "wavelengths_nm (a list in nm, or {start, stop, step})")
-            lists = [(f"water.layers[{i}].{key}", getattr(layer, key))
-                     for key in ("a", "b", "bb_ratio")]
-            lists += [(f"water.layers[{i}].components[{k}].{key}", value)
-                      for k, component in enumerate(layer.components or ())
-                      for key, value in component if isinstance(value, list)]
-            for key, value in lists:
-                check_count(key, value, n_wavelengths, spectral)
+        for key, value in self.spectral_values():
+            check_count(key, value, n_wavelengths, spectral)
+
+    def spectral_values(self) -> list[tuple[str, object]]:
+        """(key path, value) of every key that may hold one value per wavelength: a layer's a,
+        b and bb_ratio, and a component's lists."""
+        values = []
+        for i, layer in enumerate(self.layers):
+            values += [(f"water.layers[{i}].{key}", getattr(layer, key))
+                       for key in ("a", "b", "bb_ratio")]
+            values += [(f"water.layers[{i}].components[{k}].{key}", value)
+                       for k, component in enumerate(layer.components or ())
+                       for key, value in component if isinstance(value, list)]
+        return values
 
     @property
     def depth_m(self) -> float:
