@@ -8,7 +8,7 @@ from .. import config as cfg
 from ..config import ConfigError
 from ..config.illumination import MAX_ED0, MIN_ED0
 from ..config.wavelengths import MAX_WAVELENGTH_NM, MIN_WAVELENGTH_NM
-from .tables import interpolate, read_table
+from .tables import OutsideTable, interpolate, read_table
 
 # the day of year SPECTRL2's Earth-Sun distance correction uses when neither day_of_year nor
 # sun_position is given: 4 April, when the distance is 1 AU to 0.1%
@@ -64,9 +64,9 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
             table = read_table(spectrum.file, where, TABLE_COLUMNS)
             ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where,
                                         spectrum.file) for name in ("Ed0", "diffuse_fraction"))
-    except ConfigError as exc:
+    except OutsideTable as exc:
         added = config.added_wavelengths
-        if added and any(f"wavelength {w:g} nm is outside" in str(exc) for w in added):
+        if any(np.isclose(exc.wavelength, w) for w in added):
             # (a wavelength the user never asked for: say where it came from)
             raise ConfigError(f"{exc} (traced for the excitation of water.inelastic, which "
                               f"adds {min(added):g}-{max(added):g} nm; ask for longer "

@@ -110,11 +110,22 @@ def read_table(path: str, where: str, ranges: dict[str, tuple[float, float, str]
     return table
 
 
+class OutsideTable(ConfigError):
+    """A wavelength outside a table's range (interpolate); `wavelength` says which, so that a
+    caller can say where that wavelength came from (its default lets pickle rebuild it from
+    the message, as a sweep's worker sends it)."""
+
+    def __init__(self, message: str, wavelength: float = float("nan")) -> None:
+        super().__init__(message)
+        self.wavelength = wavelength
+
+
 def interpolate(wavelengths: np.ndarray, nodes: np.ndarray, values: np.ndarray, where: str,
                 what: str) -> np.ndarray:
     """Linear interpolation; every wavelength must lie within the table's nodes."""
     outside = (wavelengths < nodes[0]) | (wavelengths > nodes[-1])
     if outside.any():
-        raise ConfigError(f"{where}: wavelength {wavelengths[outside][0]:g} nm is outside the "
-                          f"{what} table's range {nodes[0]:g}-{nodes[-1]:g} nm")
+        first = float(wavelengths[outside][0])
+        raise OutsideTable(f"{where}: wavelength {first:g} nm is outside the {what} table's "
+                           f"range {nodes[0]:g}-{nodes[-1]:g} nm", first)
     return np.interp(wavelengths, nodes, values)
