@@ -71,21 +71,31 @@ def test_no_chlorophyll_is_pure_water():
     assert np.array_equal(alone.a, with_zero.a) and np.array_equal(alone.b, with_zero.b)
 
 
-def test_it_covers_350_to_750_nm_continuously_and_never_flat():
-    wl = np.arange(350.0, 751.0, 1.0)
+def test_beyond_bricaud_it_is_hydrolight_s_mid_uv_table():
+    """Outside 400-700 nm a_p = A_p Chl^E_p with HydroLight's new Case 1 coefficients with
+    mid-ultraviolet absorption (AEmidUVabs.txt: 0.0736, 0.8524 at 300 nm; 0.0453, 0.7702 at
+    350 nm; 0.0002, 1 at 715 nm; 0 from 720 nm), continuous where it meets Bricaud's table at
+    400 and 700 nm, continued below 300 nm with its own log-slope (never flat); a_ph at most
+    a_p."""
     for chl in (0.03, 1.0, 10.0):
-        a_p = case1.particle_absorption(chl, wl)
-        assert np.all(np.isfinite(a_p)) and np.all(a_p > 0.0)
-        below, above = a_p[wl < 400.0], a_p[wl > 700.0]
-        assert np.all(np.diff(below) != 0.0) and np.all(np.diff(above) < 0.0)  # not held flat
+        a_p = case1.particle_absorption(chl, np.array([300.0, 350.0, 715.0, 720.0, 900.0]))
+        assert a_p[:3] == pytest.approx([0.0736 * chl ** 0.8524, 0.0453 * chl ** 0.7702,
+                                         0.0002 * chl], rel=1e-9)
+        assert a_p[3] == 0.0 and a_p[4] == 0.0
         for edge in (400.0, 700.0):   # continuous at the table's ends
             near = case1.particle_absorption(chl, np.array([edge - 1e-9, edge, edge + 1e-9]))
-            assert np.ptp(near) < 1e-9 * near[1]
+            assert np.ptp(near) < 1e-6 * near[1]
+        below = case1.particle_absorption(chl, np.array([280.0, 290.0, 300.0]))
+        assert np.all(np.diff(below) != 0.0) and np.all(below > 0.0)
+        wl = np.arange(250.0, 1001.0, 1.0)
+        a_phi = case1.phytoplankton_absorption(chl, wl)
+        assert np.all(a_phi <= case1.particle_absorption(chl, wl)) and np.all(a_phi >= 0.0)
     iops = layer(0.3, [350.0, 750.0])
     assert np.all(np.isfinite(iops.a)) and np.all(iops.b > 0.0)
-    # the continuation is computed in logarithms: the smallest chlorophyll underflows to 0,
-    # never 0/0 (math domain error before), at the widest wavelengths allowed
+    # the smallest chlorophyll: finite and not negative at the widest wavelengths allowed
     tiny = case1.particle_absorption(5e-324, np.array([100.0, 440.0, 10000.0]))
+    assert np.all(np.isfinite(tiny)) and np.all(tiny >= 0.0)
+    tiny = case1.phytoplankton_absorption(5e-324, np.array([100.0, 440.0, 10000.0]))
     assert np.all(np.isfinite(tiny)) and np.all(tiny >= 0.0)
 
 

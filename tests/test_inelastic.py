@@ -35,7 +35,8 @@ from oceanmc.optics.inelastic import channels, factors, transfer
 from oceanmc.optics.inelastic import chlorophyll_fluorescence as fluorescence
 from oceanmc.optics.inelastic import raman
 from oceanmc.run.simulation import prepare
-from oceanmc.validation.cases.inelastic import clear_water
+from oceanmc.validation.cases.inelastic import LEE_2013_RTOL, clear_water
+from oceanmc.validation.raman_reference import lee_2013_raman_share
 
 from inelastic_helpers import (assert_budgets_close, assert_estimates_agree, hat_integral,
                                trapezoid_weights, z_of)
@@ -439,10 +440,13 @@ def test_inelastic_light_where_expected(whole):
             lit = np.abs(grid - 685.0) <= 15.0
         assert dark.any() and (rrs[dark] == 0.0).all(), part
         assert (rrs[lit] > Z_MAX * se[lit]).all(), (part, (rrs / np.where(se > 0, se, 1))[lit])
-    # Raman light is 5-25% of Rrs(550) in clear ocean water (the validation case's range)
+    # the Raman share of Rrs(550) in clear ocean water as Lee et al. (2013)'s empirical Eq. 11
+    # has it from the run's own Rrs(443) / Rrs(550) (the validation case's bound)
     k = int(np.argmin(np.abs(grid - 550.0)))
-    share = whole["raman/air/Rrs_nadir"][k] / whole["air/Rrs_nadir"][k]
-    assert 0.05 < share < 0.25, share
+    rrs = whole["air/Rrs_nadir"]
+    share = whole["raman/air/Rrs_nadir"][k] / rrs[k]
+    expected = lee_2013_raman_share(np.interp(443.0, grid, rrs), rrs[k])
+    assert abs(share / expected - 1.0) < LEE_2013_RTOL, (share, expected)
 
 
 def test_every_part_budget_closes(whole):

@@ -82,18 +82,32 @@ def test_chlorophyll_bricaud_1998_and_morel_maritorena_2001():
     assert iop.weights.sum(axis=1) == pytest.approx([1.0, 1.0])
 
 
-def test_chlorophyll_beyond_bricaud_range_continues_the_edge_slope():
-    """Outside 400-700 nm a_ph continues exponentially with the table's own log-slope over its
-    last 10 nm (chlorophyll.bricaud), never held flat: Raman light at 400 nm is excited near
-    350 nm."""
-    wl = np.array([350.0, 380.0, 400.0, 410.0, 690.0, 700.0, 720.0])
-    a = optics.column_iops(scene([{"model": "chlorophyll", "chl_mg_m3": 1.0}], list(wl)))[0].a
-    slope = (np.log(a[2]) - np.log(a[3])) / (400.0 - 410.0)
-    assert np.log(a[0] / a[2]) == pytest.approx(slope * -50.0, rel=1e-9)
-    assert np.log(a[1] / a[2]) == pytest.approx(slope * -20.0, rel=1e-9)
-    red = (np.log(a[5]) - np.log(a[4])) / 10.0
-    assert np.log(a[6] / a[5]) == pytest.approx(red * 20.0, rel=1e-9)
-    assert a[0] != a[2] and a[6] != a[5]
+def test_chlorophyll_beyond_bricaud_range_follows_published_shapes():
+    """Below 400 nm a_ph takes the shape of Vasilkov et al. (2005)'s a*_ph = A Chl^-B (their
+    Table 1: A, B = 0.0709, 0.153 at 350 nm and 0.0520, 0.198 at 400 nm), joined to Bricaud's
+    a_ph at 400 nm; above 700 nm the shape of HydroLight's particle absorption (A_p, E_p =
+    0.0002, 1 at 715 nm; Bricaud's 0.0039342, 1.0131636 at 700 nm), 0 from 720 nm; below 300 nm
+    the ultraviolet table's own log-slope over 300-310 nm, never held flat: Raman light at 400
+    nm is excited near 350 nm."""
+    chl = 1.0 / 3.0
+    wl = np.array([290.0, 300.0, 310.0, 350.0, 400.0, 700.0, 715.0, 720.0, 800.0])
+    # (with pure water: the infinitely deep layer needs a > 0, and a_ph is 0 from 720 nm)
+    a = optics.column_iops(scene([{"model": "pure_water"},
+                                  {"model": "chlorophyll", "chl_mg_m3": chl}], list(wl)))[0].a
+    a_ph = a - optics.column_iops(scene([{"model": "pure_water"}], list(wl)))[0].a
+    a400 = 0.0240515 * chl ** 0.687735            # Bricaud et al. (1998) A_phi, E_phi at 400 nm
+    assert a_ph[4] == pytest.approx(a400, rel=1e-9)
+    assert a_ph[3] == pytest.approx(a400 * 0.0709 * chl ** -0.153 / (0.0520 * chl ** -0.198),
+                                    rel=1e-9)
+    assert a_ph[3] > a_ph[4]                      # it rises into the ultraviolet
+    a700 = 0.00248126 * chl ** 1.028608
+    assert a_ph[5] == pytest.approx(a700, rel=1e-9)
+    assert a_ph[6] == pytest.approx(a700 * 0.0002 * chl / (0.0039342 * chl ** 1.0131636),
+                                    rel=1e-9)
+    assert a_ph[7] == 0.0 and a_ph[8] == 0.0
+    slope = np.log(a_ph[1] / a_ph[2]) / -10.0
+    assert np.log(a_ph[0] / a_ph[1]) == pytest.approx(slope * -10.0, rel=1e-6)
+    assert a_ph[0] != a_ph[1]
 
 
 def test_cdom_particles_constant_and_their_sum():

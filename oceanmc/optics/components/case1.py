@@ -27,16 +27,13 @@ Backscatter: two populations (Morel et al. 2002): a share alpha = 0.855 (0.5 - 0
   small- and large-particle phase functions, which oceanmc does not ship; Fournier-Forand with
   the same bb/b is what oceanmc's other particle models use, Mobley et al. 2002).
 
-Beyond 400-700 nm (the range of the Bricaud table): HydroLight extends A_p and E_p to 300 and
-1000 nm with a data file (user-selectable ultraviolet absorption) that is not published with its
-numbers and is not shipped here. oceanmc continues a_p(l; Chl) exponentially from each end of the
-table with the log-slope the table itself has over its last 10 nm at that Chl (chlorophyll.py
-bricaud), never
-holding it flat: in the red a_p falls on, as it does beyond the 676 nm chlorophyll peak; in the
-ultraviolet (350-400 nm) it falls slowly (a_p(350) = 0.69 a_p(400) at Chl 1), where CDOM, which
-is exponential everywhere and needs no table, already outweighs the particles (0.2 a_p(440)
-exp(0.014 x 90) = 0.7 a_p(440) at 350 nm). This continuation is oceanmc's, not the model's; the
-README says so."""
+Beyond 400-700 nm (the range of the Bricaud table): HydroLight's own coefficients with
+mid-ultraviolet absorption (Mobley, Ocean Optics Web Book, the new Case 1 IOP model's
+AEmidUVabs.txt, 300-1000 nm: after Morrison & Nelson 2004 and Vasilkov et al. 2005 below 400 nm;
+0 from 720 nm; chlorophyll.particle_absorption), continued below 300 nm with the table's own
+log-slope. The living part, a_ph, is Bricaud's A_phi, E_phi with Vasilkov et al. (2005)'s
+ultraviolet shape (chlorophyll.phytoplankton_absorption), held at most a_p (at Chl below about
+0.001 mg/m3 near 300 nm the two tables' shapes would put it above)."""
 from __future__ import annotations
 
 import math
@@ -44,7 +41,7 @@ import math
 import numpy as np
 
 from . import Contribution, fournier_forand_by_ratio
-from .chlorophyll import bricaud
+from . import chlorophyll
 
 F_CDOM = 0.2
 S_CDOM = 0.014          # 1/nm
@@ -55,15 +52,15 @@ BB_SMALL = BB_LARGE + 0.01 / SMALL_SHARE_COEF
 
 
 def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_p (1/m) at any wavelength, Chl > 0: A_p Chl^E_p, continued beyond the table's
-    400-700 nm by chlorophyll.bricaud."""
-    return bricaud(chl, wavelengths_nm, "A_p", "E_p")
+    """a_p (1/m) at any wavelength, Chl > 0 (chlorophyll.particle_absorption)."""
+    return chlorophyll.particle_absorption(chl, wavelengths_nm)
 
 
 def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """a_phi = A_phi Chl^E_phi (Bricaud et al. 1998), continued likewise: the living part of
-    a_p, which fluoresces (optics/inelastic/)."""
-    return bricaud(chl, wavelengths_nm)
+    a_p, which fluoresces (optics/inelastic/), at most a_p."""
+    return np.minimum(chlorophyll.phytoplankton_absorption(chl, wavelengths_nm),
+                      particle_absorption(chl, wavelengths_nm))
 
 
 def cdom_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:

@@ -1,8 +1,9 @@
 """Case-1 phytoplankton and the particles that covary with chlorophyll (Chl, mg/m3).
 
 Absorption: a_ph(lambda) = A_phi(lambda) Chl^E_phi(lambda) (Bricaud et al. 1998, J. Geophys. Res.
-103, 31033; the 2-nm table of A_phi, E_phi, 400-700 nm, in oceanmc/data; continued beyond it by
-bricaud()). It is all phytoplankton absorption, so all of it may fluoresce (optics/inelastic/).
+103, 31033; the 2-nm table of A_phi, E_phi, 400-700 nm, in oceanmc/data), with Vasilkov et al.
+(2005)'s ultraviolet shape below 400 nm (phytoplankton_absorption). It is all phytoplankton
+absorption, so all of it may fluoresce (optics/inelastic/).
 Scattering: b_p(lambda) = 0.416 Chl^0.766 (550 / lambda) (Morel & Maritorena 2001, J. Geophys.
 Res. 106, 7163, after Loisel & Morel 1998).
 Backscatter fraction: bb_p/b_p = 0.002 + 0.01 (0.5 - 0.25 log10 Chl) (lambda / 550)^nu, with
@@ -18,52 +19,103 @@ import numpy as np
 from ..tables import packaged
 from . import Contribution, fournier_forand_by_ratio
 
-BRICAUD = "chlorophyll_absorption_bricaud_1998.csv"
+BRICAUD = "chlorophyll_absorption_bricaud_1998.csv"            # A_p, E_p, A_phi, E_phi: 400-700 nm
+HYDROLIGHT_TAILS = "particle_absorption_hydrolight_mid_uv.csv"  # A_p, E_p: 300-398, 715-1000 nm
+VASILKOV = "phytoplankton_absorption_uv_vasilkov_2005.csv"      # a*_ph = A Chl^-B: 300-400 nm
 
-
-# the table span whose log-slope continues a Bricaud coefficient pair beyond each end of the table
+TABLE_LOW_NM, TABLE_HIGH_NM = 400.0, 700.0        # Bricaud et al. (1998)'s range
+UV_LOW_NM = 300.0                                  # where the ultraviolet tables start
+# the span whose log-slope continues the ultraviolet tables below UV_LOW_NM
 EDGE_NM = 10.0
 
 
-def _coefficients(wavelengths_nm: np.ndarray, a_column: str, e_column: str
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """A and E of one Bricaud column pair, interpolated linearly in the table (400-700 nm)."""
+def _bricaud(chl: float, wavelengths_nm: np.ndarray, a_column: str, e_column: str
+             ) -> np.ndarray:
+    """A Chl^E from one Bricaud et al. (1998) column pair, A and E interpolated linearly in the
+    2-nm table (wavelengths inside 400-700 nm)."""
     table = packaged(BRICAUD)
     nodes = table["wavelength_nm"]
-    return (np.interp(wavelengths_nm, nodes, table[a_column]),
-            np.interp(wavelengths_nm, nodes, table[e_column]))
+    return (np.interp(wavelengths_nm, nodes, table[a_column])
+            * chl ** np.interp(wavelengths_nm, nodes, table[e_column]))
 
 
-def bricaud(chl: float, wavelengths_nm: np.ndarray, a_column: str = "A_phi",
-            e_column: str = "E_phi") -> np.ndarray:
-    """A Chl^E (1/m) at any wavelength, Chl > 0: the Bricaud et al. (1998) table inside
-    400-700 nm (A_phi, E_phi: phytoplankton; A_p, E_p: all particles), continued outside
-    exponentially with the log-slope the table itself has over its last EDGE_NM at that Chl
-    (in logarithms, which do not underflow), never held flat. Bricaud et al. publish no
-    extension; this continuation is oceanmc's (HydroLight extends the table with a data file
-    whose numbers are not published): in the red the absorption falls on, as it does beyond
-    the 676 nm peak; in the ultraviolet (350-400 nm) it falls slowly (a_phi(350) = 0.7
-    a_phi(400) at Chl 1), where CDOM, exponential everywhere, already outweighs it."""
-    nodes = packaged(BRICAUD)["wavelength_nm"]
-    low, high = float(nodes[0]), float(nodes[-1])
+def _continued_below(values, chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+    """values(chl, wl) at wl >= UV_LOW_NM, continued below it exponentially with the log-slope
+    the table has over its first EDGE_NM (oceanmc's own rule: no published model reaches below
+    300 nm; never held flat)."""
     wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    a_coef, e_coef = _coefficients(np.clip(wl, low, high), a_column, e_column)
-    out = a_coef * chl ** e_coef
-    for edge, inner, outside in ((low, low + EDGE_NM, wl < low), (high, high - EDGE_NM, wl > high)):
-        if outside.any():
-            a_pair, e_pair = _coefficients(np.array([edge, inner]), a_column, e_column)
-            log_pair = np.log(a_pair) + e_pair * math.log(chl)     # ln a at edge and inner
-            slope = (log_pair[0] - log_pair[1]) / (edge - inner)  # d ln a / d lambda
-            out[outside] = np.exp(log_pair[0] + slope * (wl[outside] - edge))
+    out = values(chl, np.maximum(wl, UV_LOW_NM))
+    below = wl < UV_LOW_NM
+    if below.any():
+        edge, inner = values(chl, np.array([UV_LOW_NM, UV_LOW_NM + EDGE_NM]))
+        if edge > 0.0 and inner > 0.0:   # (both 0 where Chl^E underflows)
+            slope = math.log(edge / inner) / -EDGE_NM        # d ln a / d lambda
+            out[below] = edge * np.exp(slope * (wl[below] - UV_LOW_NM))
+        else:
+            out[below] = 0.0
     return out
 
 
+def _particle_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+    """A_p Chl^E_p at 300-1000 nm: Bricaud et al. (1998) inside 400-700 nm, HydroLight's mid-UV
+    coefficient file outside it (0 from 720 nm; beyond 1000 nm its last row, 0)."""
+    table, tails = packaged(BRICAUD), packaged(HYDROLIGHT_TAILS)
+    below, above = tails["wavelength_nm"] < TABLE_LOW_NM, tails["wavelength_nm"] > TABLE_HIGH_NM
+
+    def joined(tail_column: str, table_column: str) -> np.ndarray:
+        return np.concatenate([tails[tail_column][below], table[table_column],
+                               tails[tail_column][above]])
+    nodes = joined("wavelength_nm", "wavelength_nm")
+    return (np.interp(wavelengths_nm, nodes, joined("A_p", "A_p"))
+            * chl ** np.interp(wavelengths_nm, nodes, joined("E_p", "E_p")))
+
+
+def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+    """a_p (1/m), all particles, Chl > 0: A_p Chl^E_p, Bricaud et al. (1998) at 400-700 nm and
+    HydroLight's new Case 1 model's coefficients with mid-ultraviolet absorption outside it
+    (Mobley, Ocean Optics Web Book, AEmidUVabs.txt: 300-1000 nm, 0 from 720 nm), so that
+    case1's particles are HydroLight's in the ultraviolet too; continued below 300 nm by
+    _continued_below."""
+    return _continued_below(_particle_table, chl, wavelengths_nm)
+
+
+def _phytoplankton_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+    """a_ph at 300-1000 nm (phytoplankton_absorption)."""
+    wl = np.asarray(wavelengths_nm, dtype=np.float64)
+    out = _bricaud(chl, np.clip(wl, TABLE_LOW_NM, TABLE_HIGH_NM), "A_phi", "E_phi")
+    uv = wl < TABLE_LOW_NM
+    if uv.any():
+        table = packaged(VASILKOV)
+        nodes = table["wavelength_nm"]
+
+        def shape(at: np.ndarray) -> np.ndarray:     # a*_ph = A Chl^-B (Vasilkov et al. 2005)
+            return np.interp(at, nodes, table["A"]) * chl ** -np.interp(at, nodes, table["B"])
+        out[uv] *= shape(wl[uv]) / shape(np.array([TABLE_LOW_NM]))
+    red = wl > TABLE_HIGH_NM
+    if red.any():
+        edge = _particle_table(chl, np.array([TABLE_HIGH_NM]))[0]
+        # (0 where Chl^E underflows at 700 nm, as a_ph there does)
+        out[red] = out[red] * _particle_table(chl, wl[red]) / edge if edge > 0.0 else 0.0
+    return out
+
+
+def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
+    """a_ph (1/m), Chl > 0: A_phi Chl^E_phi (Bricaud et al. 1998) at 400-700 nm; below 400 nm
+    with the spectral shape of Vasilkov et al. (2005, Appl. Opt. 44, 2863, Table 1: a*_ph = A
+    Chl^-B, 300-400 nm, which rises into the ultraviolet: 1.16 a_ph(400) at 350 nm at Chl 0.03,
+    1.36 at Chl 1), joined to Bricaud's a_ph at 400 nm, as libRadtran joins them (its A(400) is
+    twice Bricaud's A_phi(400): other samples); above 700 nm with the shape of HydroLight's
+    particle absorption (particle_absorption), joined at 700 nm, which falls to 0 at 720 nm;
+    below 300 nm continued by _continued_below."""
+    return _continued_below(_phytoplankton_table, chl, wavelengths_nm)
+
+
 def absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_ph (1/m): A_phi Chl^E_phi (Bricaud et al. 1998), continued beyond 400-700 nm
-    (bricaud); 0 without chlorophyll."""
+    """a_ph (1/m) of the chlorophyll component (phytoplankton_absorption); 0 without
+    chlorophyll."""
     if chl <= 0.0:
         return np.zeros(len(wavelengths_nm))
-    return bricaud(chl, wavelengths_nm)
+    return phytoplankton_absorption(chl, wavelengths_nm)
 
 
 def scattering(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
