@@ -12,7 +12,7 @@ import yaml
 
 from oceanmc.cli import main
 from oceanmc.plot import close
-from oceanmc.plot.results import open_result, plot_result, rrs_figure
+from oceanmc.plot.results import added_spans, open_result, plot_result, rrs_figure
 from oceanmc.run.hdf5 import load_result
 from oceanmc.run.results import format_summary, wavelength_ranges
 
@@ -154,3 +154,14 @@ def test_a_run_without_inelastic_light_shows_none_of_it(elastic_run, tmp_path):
 ])
 def test_added_wavelengths_in_few_words(wavelengths, said):
     assert wavelength_ranges(np.array(wavelengths, dtype=float)) == said
+
+
+def test_the_shaded_spans_cover_every_added_wavelength():
+    """Asked 400 and 550 nm with Raman light: the run adds 340-390 nm below them and others
+    between them; each run of added wavelengths is shaded from halfway to its asked neighbours
+    (the grid's end where there is none), and no asked wavelength is inside a span."""
+    grid = np.array([340.0, 350.0, 400.0, 450.0, 460.0, 550.0])
+    added = np.array([340.0, 350.0, 450.0, 460.0])
+    assert added_spans(grid, added) == [(340.0, 375.0), (425.0, 505.0)]
+    assert added_spans(grid, np.array([])) == []
+    assert added_spans(np.array([400.0, 550.0, 600.0]), np.array([600.0])) == [(575.0, 600.0)]

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..config.loading import file_problem
 from ..run.format import SWEEP_DATASET_MESSAGE, SWEEP_TITLE
-from ..run.results import PART_LABELS, lowest_requested
+from ..run.results import PART_LABELS
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
 # at most this many wavelengths share a profile panel (evenly spaced over the file's grid), so
@@ -206,9 +206,9 @@ def rrs_parts(ax, result: ResultFile, whole: np.ndarray) -> None:
     """The parts of Rrs nadir of a run with inelastic light (PART/air/Rrs_nadir) on the Rrs
     axes, beside the whole, each with error bars of one standard error, on a log axis (they
     span decades); zeros are left out (Raman light at a wavelength whose excitation lies below
-    the traced grid, fluorescence away from its band). The wavelengths the run added below
-    those asked for, for the excitation, are shaded: their own inelastic light lacks what is
-    excited below the traced grid."""
+    the traced grid, fluorescence away from its band). The wavelengths the run added for the
+    excitation, below those asked for or between them, are shaded (added_spans): their own
+    inelastic light lacks what is excited off the traced grid."""
     grid = result.wavelengths
     ax.set_yscale("log", nonpositive="clip")
     drawn = [whole]
@@ -228,12 +228,31 @@ def rrs_parts(ax, result: ResultFile, whole: np.ndarray) -> None:
         ax.set_ylim(max(float(positive.min()), top / RRS_PARTS_RANGE) / 1.5, 2.0 * top)
     added = np.atleast_1d(np.asarray(result.water.attrs.get("wavelengths_added_nm", []),
                                      dtype=np.float64))
-    if added.size:
-        first = lowest_requested(grid, added)
-        below = added[added < first]
-        if below.size:
-            ax.axvspan(grid[0], 0.5 * (below.max() + first), color="0.6", alpha=0.15, lw=0,
-                       label="added for the excitation")
+    label = "added for the excitation"
+    for lo, hi in added_spans(grid, added):
+        ax.axvspan(lo, hi, color="0.6", alpha=0.15, lw=0, label=label)
+        label = None
+
+
+def added_spans(grid: np.ndarray, added: np.ndarray) -> list[tuple[float, float]]:
+    """(left, right) in nm of each run of neighbouring grid wavelengths that the run added for
+    the excitation (below the asked ones or between them), from halfway to the asked neighbour
+    on each side (the grid's end where there is none)."""
+    is_added = np.array([np.isclose(added, w).any() for w in grid], dtype=bool)
+    spans = []
+    k = 0
+    while k < len(grid):
+        if not is_added[k]:
+            k += 1
+            continue
+        end = k
+        while end + 1 < len(grid) and is_added[end + 1]:
+            end += 1
+        left = grid[0] if k == 0 else 0.5 * (grid[k - 1] + grid[k])
+        right = grid[-1] if end == len(grid) - 1 else 0.5 * (grid[end] + grid[end + 1])
+        spans.append((float(left), float(right)))
+        k = end + 1
+    return spans
 
 
 PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward plane irradiance Eu"),
