@@ -9,7 +9,7 @@ import oceanmc
 from conftest import REPO
 from oceanmc import optics
 from oceanmc.config import ConfigError
-from oceanmc.optics.components import case1
+from oceanmc.optics.components import case1, chlorophyll
 from oceanmc.optics.tables import packaged, read_csv
 
 MM01 = REPO.parent / "shared" / "data" / "kd_morel_maritorena_2001.csv"
@@ -77,7 +77,7 @@ def test_beyond_bricaud_it_is_hydrolight_s_mid_uv_table():
     350 nm; 0.0002, 1 at 715 nm; 0 from 720 nm), continuous where it meets Bricaud's table at
     400 and 700 nm, continued below 300 nm with its own log-slope (never flat); a_ph at most
     a_p."""
-    for chl in (0.03, 1.0, 10.0):
+    for chl in (0.003, 0.03, 1.0, 10.0, 100.0):
         a_p = case1.particle_absorption(chl, np.array([300.0, 350.0, 715.0, 720.0, 900.0]))
         assert a_p[:3] == pytest.approx([0.0736 * chl ** 0.8524, 0.0453 * chl ** 0.7702,
                                          0.0002 * chl], rel=1e-9)
@@ -87,9 +87,11 @@ def test_beyond_bricaud_it_is_hydrolight_s_mid_uv_table():
             assert np.ptp(near) < 1e-6 * near[1]
         below = case1.particle_absorption(chl, np.array([280.0, 290.0, 300.0]))
         assert np.all(np.diff(below) != 0.0) and np.all(below > 0.0)
-        wl = np.arange(250.0, 1001.0, 1.0)
-        a_phi = case1.phytoplankton_absorption(chl, wl)
-        assert np.all(a_phi <= case1.particle_absorption(chl, wl)) and np.all(a_phi >= 0.0)
+        # the phytoplankton's own curve (before case1 holds it at most a_p) stays below the
+        # particles' at every wavelength, below 300 nm too, from 0.003 mg/m3 up
+        wl = np.arange(150.0, 1001.0, 1.0)
+        a_ph = chlorophyll.phytoplankton_absorption(chl, wl)
+        assert np.all(a_ph <= case1.particle_absorption(chl, wl)) and np.all(a_ph >= 0.0)
     iops = layer(0.3, [350.0, 750.0])
     assert np.all(np.isfinite(iops.a)) and np.all(iops.b > 0.0)
     # the smallest chlorophyll: finite and not negative at the widest wavelengths allowed

@@ -87,8 +87,8 @@ def test_chlorophyll_beyond_bricaud_range_follows_published_shapes():
     Table 1: A, B = 0.0709, 0.153 at 350 nm and 0.0520, 0.198 at 400 nm), joined to Bricaud's
     a_ph at 400 nm; above 700 nm the shape of HydroLight's particle absorption (A_p, E_p =
     0.0002, 1 at 715 nm; Bricaud's 0.0039342, 1.0131636 at 700 nm), 0 from 720 nm; below 300 nm
-    the ultraviolet table's own log-slope over 300-310 nm, never held flat: Raman light at 400
-    nm is excited near 350 nm."""
+    the particles' own continuation (their table's log-slope over 300-310 nm), never held flat:
+    Raman light at 400 nm is excited near 350 nm."""
     chl = 1.0 / 3.0
     wl = np.array([290.0, 300.0, 310.0, 350.0, 400.0, 700.0, 715.0, 720.0, 800.0])
     # (with pure water: the infinitely deep layer needs a > 0, and a_ph is 0 from 720 nm)
@@ -99,14 +99,18 @@ def test_chlorophyll_beyond_bricaud_range_follows_published_shapes():
     assert a_ph[4] == pytest.approx(a400, rel=1e-9)
     assert a_ph[3] == pytest.approx(a400 * 0.0709 * chl ** -0.153 / (0.0520 * chl ** -0.198),
                                     rel=1e-9)
+    assert a_ph[1] == pytest.approx(a400 * 0.1023 * chl ** -0.0983 / (0.0520 * chl ** -0.198),
+                                    rel=1e-9)
     assert a_ph[3] > a_ph[4]                      # it rises into the ultraviolet
     a700 = 0.00248126 * chl ** 1.028608
     assert a_ph[5] == pytest.approx(a700, rel=1e-9)
     assert a_ph[6] == pytest.approx(a700 * 0.0002 * chl / (0.0039342 * chl ** 1.0131636),
                                     rel=1e-9)
     assert a_ph[7] == 0.0 and a_ph[8] == 0.0
-    slope = np.log(a_ph[1] / a_ph[2]) / -10.0
-    assert np.log(a_ph[0] / a_ph[1]) == pytest.approx(slope * -10.0, rel=1e-6)
+    # below 300 nm as the particles' HydroLight table continues (A_p, E_p = 0.0736, 0.8524 at
+    # 300 nm and 0.0767, 0.8453 at 310 nm): ln a_p(290) - ln a_p(300) = ln a_p(300) - ln a_p(310)
+    ln_ap = [math.log(0.0736) + 0.8524 * math.log(chl), math.log(0.0767) + 0.8453 * math.log(chl)]
+    assert math.log(a_ph[0] / a_ph[1]) == pytest.approx(ln_ap[0] - ln_ap[1], rel=1e-6)
     assert a_ph[0] != a_ph[1]
 
 

@@ -104,8 +104,10 @@ class PureWaterComponent(_Strict):
 
 class ChlorophyllComponent(_Strict):
     """Case-1 phytoplankton and the particles that covary with them: a_ph = A_phi Chl^E_phi
-    (Bricaud et al. 1998, 400-700 nm); b_p and bb_p of Morel & Maritorena (2001) with the
-    spectral exponent of Morel et al. (2002); Fournier-Forand phase by bb_p/b_p."""
+    (Bricaud et al. 1998, 400-700 nm; beyond it Vasilkov et al. 2005's ultraviolet shape and
+    HydroLight's red tail: optics/components/chlorophyll.py); b_p and bb_p of Morel &
+    Maritorena (2001) with the spectral exponent of Morel et al. (2002); Fournier-Forand phase
+    by bb_p/b_p."""
     model: Literal["chlorophyll"]
     chl_mg_m3: amount(MAX_CHL_MG_M3, "mg/m3")
 
@@ -113,7 +115,7 @@ class ChlorophyllComponent(_Strict):
 class Case1Component(_Strict):
     """Case-1 water's every non-water IOP from chlorophyll alone, HydroLight's "new Case 1" model
     (optics/components/case1.py): particles (phytoplankton and covarying detritus) a_p = A_p
-    Chl^E_p (Bricaud et al. 1998), CDOM 0.2 a_p(440) exp(-0.014 (lambda - 440)), b_p = 0.416
+    Chl^E_p (Bricaud et al. 1998; outside 400-700 nm HydroLight's mid-UV coefficients), CDOM 0.2 a_p(440) exp(-0.014 (lambda - 440)), b_p = 0.416
     Chl^0.766 (lambda/550)^nu and two particle populations with the bb/b of Morel et al. (2002).
     Pure water is its own component."""
     model: Literal["case1"]

@@ -249,7 +249,9 @@ def column_iops(config: cfg.SceneConfig) -> list[LayerIOPs]:
         stuck = (last.b > 0.0) & (last.a <= 0.0)
         if stuck.any():
             raise ConfigError(f"water.layers[{last.config_layer}]: an infinitely deep layer that "
-                              f"scatters needs a > 0; at {wl[stuck][0]:g} nm it has a = 0")
+                              f"scatters needs a > 0; at {wl[stuck][0]:g} nm it has a = 0 (none "
+                              f"of its components absorbs there: add pure_water, or end the "
+                              f"column at a bottom)")
     return out
 
 

@@ -207,8 +207,9 @@ def rrs_parts(ax, result: ResultFile, whole: np.ndarray) -> None:
     axes, beside the whole, each with error bars of one standard error, on a log axis (they
     span decades); zeros are left out (Raman light at a wavelength whose excitation lies below
     the traced grid, fluorescence away from its band). The wavelengths the run added for the
-    excitation, below those asked for or between them, are shaded (added_spans): their own
-    inelastic light lacks what is excited off the traced grid."""
+    excitation, below those asked for or between them, are shaded (added_spans): not asked
+    for, they are traced to excite the others (the lowest ones' own Raman light lacks what
+    would be excited below the traced grid)."""
     grid = result.wavelengths
     ax.set_yscale("log", nonpositive="clip")
     drawn = [whole]

@@ -499,14 +499,17 @@ def reference_walk(wavelengths_nm, depth_m, absorption, *, elastic=None, b488: f
 # UV-visible solar radiation in the global oceans: insights from ocean color remote sensing.
 # J. Geophys. Res. Oceans 118, 4241-4255, Eq. 11: the Raman factor of an observed Rrs at a band,
 # RF = alpha Rrs(443) / Rrs(550) + beta1 Rrs(550)^beta2 (Rrs in 1/sr), the light without Raman
-# being Rrs / (1 + RF). Coefficients at 551 nm as NASA's l2gen applies them (src/l2gen/raman.c,
-# L. McKinna 2015: alpha 0.017, beta1 0.010, beta2 -0.080), not checked against the paper's table.
-LEE_2013_AT_551 = (0.017, 0.010, -0.080)
+# being Rrs / (1 + RF). Coefficients per band as NASA's l2gen applies them (src/l2gen/raman.c,
+# L. McKinna 2015), not checked against the paper's table: band (nm): (alpha, beta1, beta2)
+LEE_2013 = {412.0: (0.003, 0.014, -0.022), 443.0: (0.004, 0.015, -0.023),
+            488.0: (0.011, 0.010, -0.051), 531.0: (0.015, 0.010, -0.070),
+            551.0: (0.017, 0.010, -0.080), 667.0: (0.018, 0.010, -0.081)}
+LEE_2013_BANDS_NM = tuple(LEE_2013)
 
 
-def lee_2013_raman_share(rrs443: float, rrs550: float) -> float:
-    """The Raman share of Rrs near 550 nm, RF / (1 + RF), by Lee et al. (2013)'s empirical Eq. 11
-    from the whole (Raman included) Rrs at 443 and 550 nm in 1/sr."""
-    alpha, beta1, beta2 = LEE_2013_AT_551
+def lee_2013_raman_share(rrs443: float, rrs550: float, band_nm: float = 551.0) -> float:
+    """The Raman share of Rrs at one of Lee et al. (2013)'s bands, RF / (1 + RF), by their
+    empirical Eq. 11 from the whole (Raman included) Rrs at 443 and 550 nm in 1/sr."""
+    alpha, beta1, beta2 = LEE_2013[band_nm]
     factor = alpha * rrs443 / rrs550 + beta1 * rrs550 ** beta2
     return factor / (1.0 + factor)

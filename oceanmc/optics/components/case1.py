@@ -33,7 +33,7 @@ AEmidUVabs.txt, 300-1000 nm: after Morrison & Nelson 2004 and Vasilkov et al. 20
 0 from 720 nm; chlorophyll.particle_absorption), continued below 300 nm with the table's own
 log-slope. The living part, a_ph, is Bricaud's A_phi, E_phi with Vasilkov et al. (2005)'s
 ultraviolet shape (chlorophyll.phytoplankton_absorption), held at most a_p (at Chl below about
-0.001 mg/m3 near 300 nm the two tables' shapes would put it above)."""
+0.002 mg/m3 the two tables would put it above a_p at 300 nm and below)."""
 from __future__ import annotations
 
 import math

@@ -25,7 +25,7 @@ VASILKOV = "phytoplankton_absorption_uv_vasilkov_2005.csv"      # a*_ph = A Chl^
 
 TABLE_LOW_NM, TABLE_HIGH_NM = 400.0, 700.0        # Bricaud et al. (1998)'s range
 UV_LOW_NM = 300.0                                  # where the ultraviolet tables start
-# the span whose log-slope continues the ultraviolet tables below UV_LOW_NM
+# the span whose log-slope continues the particle table below UV_LOW_NM
 EDGE_NM = 10.0
 
 
@@ -37,23 +37,6 @@ def _bricaud(chl: float, wavelengths_nm: np.ndarray, a_column: str, e_column: st
     nodes = table["wavelength_nm"]
     return (np.interp(wavelengths_nm, nodes, table[a_column])
             * chl ** np.interp(wavelengths_nm, nodes, table[e_column]))
-
-
-def _continued_below(values, chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """values(chl, wl) at wl >= UV_LOW_NM, continued below it exponentially with the log-slope
-    the table has over its first EDGE_NM (oceanmc's own rule: no published model reaches below
-    300 nm; never held flat)."""
-    wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    out = values(chl, np.maximum(wl, UV_LOW_NM))
-    below = wl < UV_LOW_NM
-    if below.any():
-        edge, inner = values(chl, np.array([UV_LOW_NM, UV_LOW_NM + EDGE_NM]))
-        if edge > 0.0 and inner > 0.0:   # (both 0 where Chl^E underflows)
-            slope = math.log(edge / inner) / -EDGE_NM        # d ln a / d lambda
-            out[below] = edge * np.exp(slope * (wl[below] - UV_LOW_NM))
-        else:
-            out[below] = 0.0
-    return out
 
 
 def _particle_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
@@ -74,9 +57,20 @@ def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """a_p (1/m), all particles, Chl > 0: A_p Chl^E_p, Bricaud et al. (1998) at 400-700 nm and
     HydroLight's new Case 1 model's coefficients with mid-ultraviolet absorption outside it
     (Mobley, Ocean Optics Web Book, AEmidUVabs.txt: 300-1000 nm, 0 from 720 nm), so that
-    case1's particles are HydroLight's in the ultraviolet too; continued below 300 nm by
-    _continued_below."""
-    return _continued_below(_particle_table, chl, wavelengths_nm)
+    case1's particles are HydroLight's in the ultraviolet too; below 300 nm continued
+    exponentially with the log-slope the table has over its first EDGE_NM (oceanmc's own rule:
+    no published model reaches below 300 nm; never held flat)."""
+    wl = np.asarray(wavelengths_nm, dtype=np.float64)
+    out = _particle_table(chl, np.maximum(wl, UV_LOW_NM))
+    below = wl < UV_LOW_NM
+    if below.any():
+        edge, inner = _particle_table(chl, np.array([UV_LOW_NM, UV_LOW_NM + EDGE_NM]))
+        if edge > 0.0 and inner > 0.0:   # (both 0 where Chl^E underflows)
+            slope = math.log(edge / inner) / -EDGE_NM        # d ln a / d lambda
+            out[below] = edge * np.exp(slope * (wl[below] - UV_LOW_NM))
+        else:
+            out[below] = 0.0
+    return out
 
 
 def _phytoplankton_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
@@ -95,7 +89,7 @@ def _phytoplankton_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     if red.any():
         edge = _particle_table(chl, np.array([TABLE_HIGH_NM]))[0]
         # (0 where Chl^E underflows at 700 nm, as a_ph there does)
-        out[red] = out[red] * _particle_table(chl, wl[red]) / edge if edge > 0.0 else 0.0
+        out[red] = out[red] * (_particle_table(chl, wl[red]) / edge) if edge > 0.0 else 0.0
     return out
 
 
@@ -103,11 +97,22 @@ def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarr
     """a_ph (1/m), Chl > 0: A_phi Chl^E_phi (Bricaud et al. 1998) at 400-700 nm; below 400 nm
     with the spectral shape of Vasilkov et al. (2005, Appl. Opt. 44, 2863, Table 1: a*_ph = A
     Chl^-B, 300-400 nm, which rises into the ultraviolet: 1.16 a_ph(400) at 350 nm at Chl 0.03,
-    1.36 at Chl 1), joined to Bricaud's a_ph at 400 nm, as libRadtran joins them (its A(400) is
-    twice Bricaud's A_phi(400): other samples); above 700 nm with the shape of HydroLight's
-    particle absorption (particle_absorption), joined at 700 nm, which falls to 0 at 720 nm;
-    below 300 nm continued by _continued_below."""
-    return _continued_below(_phytoplankton_table, chl, wavelengths_nm)
+    1.36 at Chl 1), joined to Bricaud's a_ph at 400 nm (the table's own A(400) is twice
+    Bricaud's A_phi(400): other samples); above 700 nm with the shape of HydroLight's particle
+    absorption (particle_absorption), joined at 700 nm, which falls to 0 at 720 nm; below 300
+    nm with the particles' own continuation (particle_absorption), so that its share of a_p
+    stays what it is at 300 nm (their two tables' slopes there, continued apart, would put a_ph
+    above a_p below 190-290 nm)."""
+    wl = np.asarray(wavelengths_nm, dtype=np.float64)
+    at_table = np.maximum(wl, UV_LOW_NM)
+    out = _phytoplankton_table(chl, at_table)
+    below = wl < UV_LOW_NM
+    if below.any():
+        edge = _particle_table(chl, np.array([UV_LOW_NM]))[0]
+        # (0 where Chl^E underflows at 300 nm, as a_ph there does)
+        out[below] = out[below] * (particle_absorption(chl, wl[below]) / edge) if edge > 0.0 \
+            else 0.0
+    return out
 
 
 def absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
