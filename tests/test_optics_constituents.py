@@ -7,10 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 import oceanmc
 from oceanmc import optics, registry
-from oceanmc.config import ConfigError
+from oceanmc.config import ConfigError, data_file_hashes
+from oceanmc.run.simulation import prepare
 
 WL = [400.0, 440.0, 550.0, 700.0]
 
@@ -132,6 +134,45 @@ def test_cdom_particles_constant_and_their_sum():
     iso = [p.model for p in iop.phases].index("isotropic")
     assert iop.weights[:, iso] == pytest.approx(0.2 / (b_p + 0.2), rel=1e-12)
     assert iop.c == pytest.approx(iop.a + iop.b)
+
+
+def test_pure_water_from_the_user_s_absorption_file(tmp_path):
+    """pure_water.absorption_file replaces the IOCCG spectrum's a_w (linear in wavelength),
+    keeps Morel's b_w; a file relative to the config's folder; problems name the key; a
+    wavelength the run added for the Raman excitation, outside the file, is said to be one; the
+    file is among those whose content the stored run hashes."""
+    (tmp_path / "aw.csv").write_text("# my water\nwavelength_nm,a\n380,0.01\n500,0.03\n"
+                                     "700,0.63\n")
+    iop = layer([{"model": "pure_water", "absorption_file": str(tmp_path / "aw.csv")}],
+                [400.0, 600.0])
+    assert iop.a == pytest.approx([0.01 + 0.02 * 20 / 120, 0.33])
+    assert iop.b == pytest.approx(layer([{"model": "pure_water"}], [400.0, 600.0]).b)
+    config = {"name": "own water", "photons": 100, "wavelengths_nm": [450.0, 550.0],
+              "illumination": {"sun_zenith_deg": 30.0}, "surface": {"model": "flat"},
+              "water": {"layers": [{"thickness_m": math.inf, "components": [
+                  {"model": "pure_water", "absorption_file": "aw.csv"}]}]},
+              "bottom": {"model": "none"}}
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(config))
+    loaded = oceanmc.load_config(path)
+    assert loaded.water.layers[0].components[0].absorption_file == str(tmp_path / "aw.csv")
+    assert str(tmp_path / "aw.csv") in data_file_hashes(loaded)
+    # Raman light at 450 nm is excited near 390 nm, which the run adds: outside a file that
+    # starts at 420 nm
+    (tmp_path / "aw.csv").write_text("wavelength_nm,a\n420,0.005\n700,0.63\n")
+    config["water"]["inelastic"] = {"raman": {}}
+    path.write_text(yaml.safe_dump(config))
+    with pytest.raises(ConfigError) as info:
+        prepare(oceanmc.load_config(path))
+    message = str(info.value)
+    assert "water.layers[0].components[0].absorption_file: wavelength " in message, message
+    assert "is outside the" in message and "(traced for the excitation of water.inelastic" \
+        in message, message
+    (tmp_path / "aw.csv").write_text("wavelength_nm,a\n380,-0.01\n700,0.63\n")
+    with pytest.raises(ConfigError, match=r"components\[0\]\.absorption_file: .*-0\.01"):
+        layer([{"model": "pure_water", "absorption_file": str(tmp_path / "aw.csv")}], [400.0])
+    with pytest.raises(ConfigError, match=r"components\[0\]\.absorption_file: .*no such file"):
+        layer([{"model": "pure_water", "absorption_file": str(tmp_path / "none.csv")}], [400.0])
 
 
 def test_table_component_and_its_errors(tmp_path):

@@ -96,10 +96,14 @@ def amount(limit: float, unit: str):
 
 class PureWaterComponent(_Strict):
     """a_w: Pope & Fry (1997), 420-727.5 nm; outside it (180-1230 nm) the IOCCG Protocols
-    (2018)'s recommended spectrum (Morel et al. 2007, Jonasz & Fournier 2007, Kou et al. 1993).
-    b_w: pure sea water, Morel (1974), 0.00288 (lambda/500)^-4.32; phase 0.06225 (1 + 0.835
-    cos^2)."""
+    (2018)'s recommended spectrum (Morel et al. 2007, Jonasz & Fournier 2007, Kou et al. 1993);
+    or the user's own from absorption_file (a CSV with columns wavelength_nm and a, in 1/m,
+    covering every traced wavelength), to match another model's water (the Raman light in the
+    blue follows pure water's absorption at 350-420 nm, where published values differ up to
+    fourfold). b_w: pure sea water, Morel (1974), 0.00288 (lambda/500)^-4.32; phase 0.06225 (1
+    + 0.835 cos^2)."""
     model: Literal["pure_water"]
+    absorption_file: FilePath | None = None
 
 
 class ChlorophyllComponent(_Strict):

@@ -623,6 +623,8 @@ def data_file_fields(config: SceneConfig) -> list[tuple[object, str, str]]:
             phases.append((getattr(component, "phase", None), f"{where}.phase"))
             if component.model == "table":
                 fields.append((component, "file", f"{where}.file"))
+            if getattr(component, "absorption_file", None) is not None:
+                fields.append((component, "absorption_file", f"{where}.absorption_file"))
             for key, value in component.__dict__.items():
                 if getattr(value, "profile", None) == "table":
                     fields.append((value, "file", f"{where}.{key}.file"))

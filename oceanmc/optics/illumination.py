@@ -8,7 +8,7 @@ from .. import config as cfg
 from ..config import ConfigError
 from ..config.illumination import MAX_ED0, MIN_ED0
 from ..config.wavelengths import MAX_WAVELENGTH_NM, MIN_WAVELENGTH_NM
-from .tables import OutsideTable, interpolate, read_table
+from .tables import interpolate, read_table
 
 # the day of year SPECTRL2's Earth-Sun distance correction uses when neither day_of_year nor
 # sun_position is given: 4 April, when the distance is 1 AU to 0.1%
@@ -54,25 +54,16 @@ def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarr
     if np.isnan(wl).any():
         raise ConfigError(f"illumination.spectrum.model = {spectrum.model!r} needs "
                           "wavelengths_nm")
-    try:
-        if spectrum.model == "spectrl2":
-            day = spectrum.day_of_year or (light.sun_position.time.timetuple().tm_yday
-                                           if light.sun_position else MEAN_DISTANCE_DAY)
-            ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
-        else:
-            where = "illumination.spectrum.file"
-            table = read_table(spectrum.file, where, TABLE_COLUMNS)
-            ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where,
-                                        spectrum.file) for name in ("Ed0", "diffuse_fraction"))
-    except OutsideTable as exc:
-        added = config.added_wavelengths
-        if any(np.isclose(exc.wavelength, w) for w in added):
-            # (a wavelength the user never asked for: say where it came from)
-            raise ConfigError(f"{exc} (traced for the excitation of water.inelastic, which "
-                              f"adds {min(added):g}-{max(added):g} nm; ask for longer "
-                              "wavelengths, or give a spectrum table that covers these)") \
-                from None
-        raise
+    # (a wavelength outside a table: run/simulation.prepare says where it came from)
+    if spectrum.model == "spectrl2":
+        day = spectrum.day_of_year or (light.sun_position.time.timetuple().tm_yday
+                                       if light.sun_position else MEAN_DISTANCE_DAY)
+        ed0, diffuse = spectrl2(spectrum, zenith, day, wl)
+    else:
+        where = "illumination.spectrum.file"
+        table = read_table(spectrum.file, where, TABLE_COLUMNS)
+        ed0, diffuse = (interpolate(wl, table["wavelength_nm"], table[name], where,
+                                    spectrum.file) for name in ("Ed0", "diffuse_fraction"))
     if np.any(ed0 <= 0.0):
         raise ConfigError(f"illumination.spectrum: Ed0 = 0 at {wl[ed0 <= 0.0][0]:g} nm; every "
                           "wavelength needs light")

@@ -119,6 +119,16 @@ class OutsideTable(ConfigError):
         super().__init__(message)
         self.wavelength = wavelength
 
+    def explained(self, added: list[float]) -> str:
+        """The message, saying where the wavelength came from when the run added it for the
+        excitation of inelastic light (`added`: SceneConfig.added_wavelengths), which the user
+        never asked for."""
+        if not any(np.isclose(self.wavelength, w) for w in added):
+            return str(self)
+        return (f"{self} (traced for the excitation of water.inelastic, which adds "
+                f"{min(added):g}-{max(added):g} nm; ask for longer wavelengths, or give a table "
+                "that covers these)")
+
 
 def interpolate(wavelengths: np.ndarray, nodes: np.ndarray, values: np.ndarray, where: str,
                 what: str) -> np.ndarray:

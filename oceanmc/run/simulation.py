@@ -27,6 +27,7 @@ from tqdm import tqdm
 
 from .. import __version__, scene
 from ..optics import iops_table, illumination_spectrum
+from ..optics.tables import OutsideTable
 from ..config import ConfigError, SceneConfig, config_to_yaml, data_file_hashes, load_config
 from ..config.loading import at_file_key
 from ..kernel.records import PACKET, packet_state_size, work_size
@@ -139,9 +140,12 @@ def prepare(config: SceneConfig) -> PreparedRun:
     """Packs a validated scene and computes its illumination spectrum, once. Raises
     ConfigError (one line) for unusable auxiliary files or tallies too large for memory."""
     data_hashes = data_file_hashes(config)   # before the build reads them
-    ed0, diffuse, _ = illumination_spectrum(config)
     try:
+        ed0, diffuse, _ = illumination_spectrum(config)
         sc = scene.build(config, (ed0, diffuse))
+    except OutsideTable as exc:
+        raise ConfigError(at_file_key(exc.explained(config.added_wavelengths), config)) \
+            from None
     except ConfigError as exc:   # (a table's own checks name the file: the key named too)
         raise type(exc)(at_file_key(str(exc), config)) from None
     check_tally_memory(config, sc)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from ..config import ConfigError, SceneConfig, config_to_yaml, load_config
 from ..config.loading import DISCRIMINATORS, file_keys
+from ..optics.tables import OutsideTable
 from .axes import SweepError, SweepSpec, parse_key_path
 
 
@@ -114,6 +115,8 @@ def check_scenes(points: list[Point], spec: SweepSpec | None = None) -> None:
             scene.build(point.config)
         except ConfigError as exc:
             text = _without_origin(exc)
+            if isinstance(exc, OutsideTable):
+                text = exc.explained(point.config.added_wavelengths)
             keys = file_keys(text, point.config)
             # (`KEY:`: a file's key path is a problem at that key)
             if spec is not None and keys and all(
