@@ -636,3 +636,22 @@ def test_sigterm_or_ignored_sigint_stops_a_sweep_with_a_valid_partial_dataset(
     assert partial.attrs["points_pending"] == 6 - done
     assert assert_points_match_single_runs(partial, path, only_done=True) == done
     assert sorted(p.name for p in tmp_path.iterdir()) == ["lut.nc", "lut.points", "sweep.yaml"]
+
+
+def test_a_wavelength_added_for_the_excitation_outside_a_table_is_said_to_be_one(tmp_path):
+    """A point's scene whose table stops above a wavelength the run adds for the Raman
+    excitation is refused with the reason (OutsideTable.explained), as a single run's is: the
+    user never asked for that wavelength."""
+    (tmp_path / "aw.csv").write_text("wavelength_nm,a\n420,0.005\n700,0.63\n")
+    base = copy.deepcopy(TINY)
+    base["wavelengths_nm"] = [450.0, 550.0]
+    base["water"] = {"layers": [{"thickness_m": 2.0, "components": [
+        {"model": "pure_water", "absorption_file": "aw.csv"}]}],
+        "inelastic": {"raman": {}}}
+    with pytest.raises(SweepError) as info:
+        oceanmc.sweeps.prepare(sweep_file(tmp_path, {"seed": [1, 2]}, base=base),
+                               tmp_path / "lut.points")
+    message = str(info.value)
+    assert "water.layers[0].components[0].absorption_file: wavelength " in message, message
+    assert "(traced for the excitation of water.inelastic, which adds " in message, message
+    assert not (tmp_path / "lut.points").exists()
