@@ -57,3 +57,30 @@ def test_resume_refuses_an_edited_table_before_running(tmp_path):
     assert done.returncode == 2, done.stderr
     assert f"content of {table} differs" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_the_summary_names_each_data_file_its_key_and_its_content_hash(tmp_path):
+    """The summary (of `run` and of `show`, one function) names every data file the scene read
+    with the key that gives it and the start of its sha256 when run, so that a result says what
+    it was made from after the file has moved or changed; a byte-order mark (Excel's "CSV
+    UTF-8") before the header is no part of the first column's name; an empty path is refused
+    as one, not read as the config's folder."""
+    import hashlib
+    from oceanmc.run.summary import format_summary
+    table = tmp_path / "aw.csv"
+    table.write_bytes(b"\xef\xbb\xbfwavelength_nm,a\n300,0.05\n800,2.0\n")
+    config = dict(SMALL_SCENE, photons=2000, batches=4, wavelengths_nm=[450.0, 550.0])
+    config["water"] = {"layers": [{"thickness_m": 5.0, "components": [
+        {"model": "pure_water", "absorption_file": "aw.csv"}]}]}
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(config))
+    result = oceanmc.simulate(path)
+    digest = hashlib.sha256(table.read_bytes()).hexdigest()
+    table.unlink()   # moved away: the result still says what it read
+    summary = " ".join(format_summary(result).split())
+    assert (f"data files (sha256 when run): water.layers[0].components[0].absorption_file = "
+            f"{table} ({digest[:12]})") in summary, summary
+    config["water"]["layers"][0]["components"][0]["absorption_file"] = ""
+    with pytest.raises(oceanmc.config.ConfigError, match=r"absorption_file = '': a file path "
+                                                          r"cannot be empty"):
+        oceanmc.load_config(config)

@@ -317,11 +317,13 @@ Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False),
                       AfterValidator(_not_at_one)]
 
 
-def _no_nul(path: str) -> str:
+def _file_path(path: str) -> str:
+    if not path.strip():   # (resolved against the config's folder, it would name the folder)
+        raise ValueError("a file path cannot be empty")
     if "\0" in path:   # the operating system cannot take it (a ValueError deep in pathlib)
         raise ValueError("a file path cannot contain a NUL byte")
     return path
 
 
 # a data file's path (relative to the YAML file's folder)
-FilePath = Annotated[str, AfterValidator(_no_nul)]
+FilePath = Annotated[str, AfterValidator(_file_path)]

@@ -183,7 +183,9 @@ def read_text_file(path: str | Path, origin: str, limit: int, too_large: str) ->
     if len(data) > limit:
         raise ConfigError(f"{origin}: {too_large}")
     try:
-        return data.decode("utf-8")
+        # (utf-8-sig: a byte-order mark, which Excel's "CSV UTF-8" writes first, is dropped, not
+        # read as part of the first column's name)
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{origin}: not UTF-8 text ({exc.reason} at byte {exc.start})"
                           ) from None

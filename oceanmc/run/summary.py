@@ -361,6 +361,35 @@ def single_wavelength(result: Result) -> float | None:
         else None
 
 
+def data_file_lines(result: Result) -> list[str]:
+    """The data files the scene read (tables of IOPs, water absorption, phase functions,
+    spectra, BRDFs, sky maps), as the config names them, each with the start of the sha256 of
+    its content when the run read it (attribute data_files_sha256), so that a result says what
+    it was made from after the file has moved or changed."""
+    import json
+    try:
+        hashes = json.loads(str(result.attrs.get("data_files_sha256", "{}")))
+    except json.JSONDecodeError:
+        return []
+    if not hashes:
+        return []
+    keys = {}
+    try:   # (the keys that name them: a stored config loads without its files)
+        import yaml
+        from ..config import ConfigError, load_config
+        from ..config.loading import data_file_fields
+        config = load_config(yaml.safe_load(result.config_yaml))
+        keys = {getattr(model, attribute): key
+                for model, attribute, key in data_file_fields(config)}
+    except (ConfigError, yaml.YAMLError, TypeError, ValueError):
+        pass
+    text = "data files (sha256 when run): " + "; ".join(
+        (f"{keys[path]} = " if path in keys else "") + f"{path} ({digest[:12]})"
+        for path, digest in hashes.items())
+    return textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ",
+                         break_on_hyphens=False, break_long_words=False)
+
+
 def format_summary(result: Result) -> str:
     a = result.attrs
     lines = [
@@ -378,6 +407,7 @@ def format_summary(result: Result) -> str:
     said = completeness_line(result)
     if said is not None:
         lines.append(said)
+    lines += data_file_lines(result)
     if "wavelength" in result.coords:
         return "\n".join(lines + format_spectrum(result))
     lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}")
