@@ -297,19 +297,26 @@ def _section_keys() -> dict[str, list[str]]:
     return found
 
 
-def _suggestion(loc: tuple) -> str:
-    """ "; did you mean KEY?" with the nearest valid key at that level, if one is close; else
-    the path of a close key in another section (`sun_zenith` at the top: illumination's
-    sun_zenith_deg), where it stands in one only."""
+def _suggested_key(loc: tuple) -> tuple[str, bool] | None:
+    """(the nearest valid key at that level, True), if one is close; else (the path of a close
+    key in another section, False) where it stands in one only (`sun_zenith` at the top:
+    illumination.sun_zenith_deg); else None."""
     key = str(loc[-1])
     here = _closest(key, schema_keys(loc[:-1]) or set())
     if here is not None:
-        return f"; did you mean {here}?"
+        return here, True
     elsewhere = _closest(key, _section_keys())
     paths = _section_keys().get(elsewhere, []) if elsewhere is not None else []
-    if len(paths) == 1:
-        return f"; did you mean {paths[0]} (not at this level)?"
-    return " (check its spelling and level)"
+    return (paths[0], False) if len(paths) == 1 else None
+
+
+def _suggestion(loc: tuple) -> str:
+    """ "; did you mean KEY?" for an unknown key (_suggested_key)."""
+    found = _suggested_key(loc)
+    if found is None:
+        return " (check its spelling and level)"
+    key, here = found
+    return f"; did you mean {key}?" if here else f"; did you mean {key} (not at this level)?"
 
 
 def schema_keys(loc: tuple) -> set[str] | None:
@@ -493,14 +500,12 @@ def _first_problem(errors: list[dict]) -> tuple[str, int]:
                    and e.get("loc") and parent(e) == parent(first)}
         unknown = [e for e in errors
                    if e.get("type") == "extra_forbidden" and parent(e) == parent(first)]
-        hints = {id(e): _suggestion(tuple(e.get("loc", ()))) for e in unknown}
-        suggested = {key: hint[len("; did you mean "):-1] for key, hint in hints.items()
-                     if hint.startswith("; did you mean")}
-        named = [e for e in unknown if id(e) in suggested]
+        suggested = {id(e): _suggested_key(tuple(e.get("loc", ()))) for e in unknown}
+        named = [e for e in unknown if suggested[id(e)] is not None]
         if named:
             # an unknown key that names a missing one (`latitude` for latitude_deg) and that
             # missing key are one problem: the count of the others says so too
-            pairs = sum(suggested[id(e)] in missing for e in named)
+            pairs = sum(suggested[id(e)][1] and suggested[id(e)][0] in missing for e in named)
             return _describe(named[0]), 1 + pairs
     loc = tuple(first.get("loc", ()))
     if loc and _is_branch_tag(loc[-1]) and first.get("type") in _WRONG_FORM:

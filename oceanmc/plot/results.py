@@ -239,21 +239,13 @@ def added_spans(grid: np.ndarray, added: np.ndarray) -> list[tuple[float, float]
     """(left, right) in nm of each run of neighbouring grid wavelengths that the run added for
     the excitation (below the asked ones or between them), from halfway to the asked neighbour
     on each side (the grid's end where there is none)."""
-    is_added = np.array([np.isclose(added, w).any() for w in grid], dtype=bool)
-    spans = []
-    k = 0
-    while k < len(grid):
-        if not is_added[k]:
-            k += 1
-            continue
-        end = k
-        while end + 1 < len(grid) and is_added[end + 1]:
-            end += 1
-        left = grid[0] if k == 0 else 0.5 * (grid[k - 1] + grid[k])
-        right = grid[-1] if end == len(grid) - 1 else 0.5 * (grid[end] + grid[end + 1])
-        spans.append((float(left), float(right)))
-        k = end + 1
-    return spans
+    is_added = [np.isclose(added, w).any() for w in grid]
+    # where a run of added wavelengths starts and where the next asked one stands
+    change = np.flatnonzero(np.diff(np.concatenate([[0], is_added, [0]]).astype(int)))
+    last = len(grid) - 1
+    return [(float(grid[0] if start == 0 else 0.5 * (grid[start - 1] + grid[start])),
+             float(grid[last] if stop > last else 0.5 * (grid[stop - 1] + grid[stop])))
+            for start, stop in zip(change[::2], change[1::2])]
 
 
 PROFILE_QUANTITIES = (("Ed", "downward plane irradiance Ed"), ("Eu", "upward plane irradiance Eu"),

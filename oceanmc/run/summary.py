@@ -4,6 +4,7 @@ spectral one, with inelastic light its parts of Rrs nadir, and what the estimato
 processes and the illumination were."""
 from __future__ import annotations
 
+import json
 import textwrap
 
 import numpy as np
@@ -366,7 +367,6 @@ def data_file_lines(result: Result) -> list[str]:
     spectra, BRDFs, sky maps), as the config names them, each with the start of the sha256 of
     its content when the run read it (attribute data_files_sha256), so that a result says what
     it was made from after the file has moved or changed."""
-    import json
     try:
         hashes = json.loads(str(result.attrs.get("data_files_sha256", "{}")))
     except json.JSONDecodeError:
@@ -386,7 +386,7 @@ def data_file_lines(result: Result) -> list[str]:
     text = "data files (sha256 when run): " + "; ".join(
         (f"{keys[path]} = " if path in keys else "") + f"{path} ({digest[:12]})"
         for path, digest in hashes.items())
-    return textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ",
+    return textwrap.wrap(text, SUMMARY_WIDTH, initial_indent="  ", subsequent_indent="    ",
                          break_on_hyphens=False, break_long_words=False)
 
 

@@ -114,9 +114,8 @@ def check_scenes(points: list[Point], spec: SweepSpec | None = None) -> None:
         try:
             scene.build(point.config)
         except ConfigError as exc:
-            text = _without_origin(exc)
-            if isinstance(exc, OutsideTable):
-                text = exc.explained(point.config.added_wavelengths)
+            text = (exc.explained(point.config.added_wavelengths)
+                    if isinstance(exc, OutsideTable) else _without_origin(exc))
             keys = file_keys(text, point.config)
             # (`KEY:`: a file's key path is a problem at that key)
             if spec is not None and keys and all(

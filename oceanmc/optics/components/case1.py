@@ -40,8 +40,9 @@ import math
 
 import numpy as np
 
-from . import Contribution, fournier_forand_by_ratio
-from . import chlorophyll
+from . import Contribution, chlorophyll, fournier_forand_by_ratio
+# a_p (1/m) at any wavelength, Chl > 0: HydroLight's Case-1 particles
+from .chlorophyll import particle_absorption
 
 F_CDOM = 0.2
 S_CDOM = 0.014          # 1/nm
@@ -49,11 +50,6 @@ B550_COEF, B550_EXPONENT = 0.416, 0.766
 SMALL_SHARE_COEF = 0.855
 BB_LARGE = 0.002
 BB_SMALL = BB_LARGE + 0.01 / SMALL_SHARE_COEF
-
-
-def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_p (1/m) at any wavelength, Chl > 0 (chlorophyll.particle_absorption)."""
-    return chlorophyll.particle_absorption(chl, wavelengths_nm)
 
 
 def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:

@@ -29,16 +29,6 @@ UV_LOW_NM = 300.0                                  # where the ultraviolet table
 EDGE_NM = 10.0
 
 
-def _bricaud(chl: float, wavelengths_nm: np.ndarray, a_column: str, e_column: str
-             ) -> np.ndarray:
-    """A Chl^E from one Bricaud et al. (1998) column pair, A and E interpolated linearly in the
-    2-nm table (wavelengths inside 400-700 nm)."""
-    table = packaged(BRICAUD)
-    nodes = table["wavelength_nm"]
-    return (np.interp(wavelengths_nm, nodes, table[a_column])
-            * chl ** np.interp(wavelengths_nm, nodes, table[e_column]))
-
-
 def _particle_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """A_p Chl^E_p at 300-1000 nm: Bricaud et al. (1998) inside 400-700 nm, HydroLight's mid-UV
     coefficient file outside it (0 from 720 nm; beyond 1000 nm its last row, 0)."""
@@ -73,45 +63,35 @@ def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     return out
 
 
-def _phytoplankton_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """a_ph at 300-1000 nm (phytoplankton_absorption)."""
-    wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    out = _bricaud(chl, np.clip(wl, TABLE_LOW_NM, TABLE_HIGH_NM), "A_phi", "E_phi")
-    uv = wl < TABLE_LOW_NM
-    if uv.any():
-        table = packaged(VASILKOV)
-        nodes = table["wavelength_nm"]
-
-        def shape(at: np.ndarray) -> np.ndarray:     # a*_ph = A Chl^-B (Vasilkov et al. 2005)
-            return np.interp(at, nodes, table["A"]) * chl ** -np.interp(at, nodes, table["B"])
-        out[uv] *= shape(wl[uv]) / shape(np.array([TABLE_LOW_NM]))
-    red = wl > TABLE_HIGH_NM
-    if red.any():
-        edge = _particle_table(chl, np.array([TABLE_HIGH_NM]))[0]
-        # (0 where Chl^E underflows at 700 nm, as a_ph there does)
-        out[red] = out[red] * (_particle_table(chl, wl[red]) / edge) if edge > 0.0 else 0.0
-    return out
-
-
 def phytoplankton_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """a_ph (1/m), Chl > 0: A_phi Chl^E_phi (Bricaud et al. 1998) at 400-700 nm; below 400 nm
     with the spectral shape of Vasilkov et al. (2005, Appl. Opt. 44, 2863, Table 1: a*_ph = A
     Chl^-B, 300-400 nm, which rises into the ultraviolet: 1.16 a_ph(400) at 350 nm at Chl 0.03,
     1.36 at Chl 1), joined to Bricaud's a_ph at 400 nm (the table's own A(400) is twice
-    Bricaud's A_phi(400): other samples); above 700 nm with the shape of HydroLight's particle
-    absorption (particle_absorption), joined at 700 nm, which falls to 0 at 720 nm; below 300
-    nm with the particles' own continuation (particle_absorption), so that its share of a_p
-    stays what it is at 300 nm (their two tables' slopes there, continued apart, would put a_ph
-    above a_p below 190-290 nm)."""
+    Bricaud's A_phi(400): other samples); above 700 nm and below 300 nm with the shape of the
+    particles' absorption (particle_absorption: HydroLight's, which falls to 0 at 720 nm, and
+    its continuation), joined at 700 and 300 nm, so that below 300 nm its share of a_p stays
+    what it is there (the two tables' slopes, continued apart, would put a_ph above a_p below
+    190-290 nm)."""
     wl = np.asarray(wavelengths_nm, dtype=np.float64)
-    at_table = np.maximum(wl, UV_LOW_NM)
-    out = _phytoplankton_table(chl, at_table)
-    below = wl < UV_LOW_NM
-    if below.any():
-        edge = _particle_table(chl, np.array([UV_LOW_NM]))[0]
-        # (0 where Chl^E underflows at 300 nm, as a_ph there does)
-        out[below] = out[below] * (particle_absorption(chl, wl[below]) / edge) if edge > 0.0 \
-            else 0.0
+    table = packaged(BRICAUD)
+    nodes, inside = table["wavelength_nm"], np.clip(wl, TABLE_LOW_NM, TABLE_HIGH_NM)
+    out = np.interp(inside, nodes, table["A_phi"]) * chl ** np.interp(inside, nodes,
+                                                                      table["E_phi"])
+    uv = wl < TABLE_LOW_NM
+    if uv.any():
+        vasilkov = packaged(VASILKOV)
+
+        def shape(at: np.ndarray) -> np.ndarray:     # a*_ph = A Chl^-B (Vasilkov et al. 2005)
+            return (np.interp(at, vasilkov["wavelength_nm"], vasilkov["A"])
+                    * chl ** -np.interp(at, vasilkov["wavelength_nm"], vasilkov["B"]))
+        out[uv] *= shape(np.maximum(wl[uv], UV_LOW_NM)) / shape(np.array([TABLE_LOW_NM]))
+    for edge_nm, beyond in ((TABLE_HIGH_NM, wl > TABLE_HIGH_NM), (UV_LOW_NM, wl < UV_LOW_NM)):
+        if beyond.any():   # (out holds a_ph at the edge there)
+            edge = particle_absorption(chl, np.array([edge_nm]))[0]
+            # (0 where Chl^E underflows at the edge, as a_ph there does)
+            out[beyond] = out[beyond] * (particle_absorption(chl, wl[beyond]) / edge) \
+                if edge > 0.0 else 0.0
     return out
 
 

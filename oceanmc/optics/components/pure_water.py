@@ -4,9 +4,9 @@ a_w: the IOCCG Protocols (2018)'s recommended spectrum, 180-1230 nm: Pope & Fry 
 Opt. 36, 8710, from 420 to 727.5 nm (at its 2.5 nm resolution); below, Morel et al. (2007),
 Limnol. Oceanogr. 52, 217, Table 2a (345-415 nm) and Jonasz & Fournier (2007) (180-340 nm);
 above, Kou et al. (1993), Appl. Opt. 32, 3531. Both tables in oceanmc/data with their
-provenance; or the user's own (absorption_file, user_absorption). (Until 2026-11-29 Smith & Baker (1981) below 380 nm, whose clearest natural waters
-absorb 2-7x more in the ultraviolet and met Pope & Fry with a step of 2.6x, 0.030 1/m at 370 nm
-to 0.0114 at 380 nm: the Raman
+provenance; or the user's own (absorption_file, user_absorption). (Until 2026-11-29 Smith &
+Baker (1981) below 380 nm, whose clearest natural waters absorb 2-7x more in the ultraviolet
+and met Pope & Fry with a step of 2.6x, 0.030 1/m at 370 nm to 0.0114 at 380 nm: the Raman
 light at 400-430 nm, excited at 345-375 nm, was too weak.)
 b_w: pure sea water after Morel (1974), b_w = 0.00288 (lambda/500)^-4.32 1/m (the power law that
 represents Morel's values; oceanmc/data/... README compares it with the printed table: within 1%
