@@ -72,8 +72,8 @@ def test_no_chlorophyll_is_pure_water():
 
 
 def test_beyond_bricaud_it_is_hydrolight_s_mid_uv_table():
-    """Outside 400-700 nm a_p = A_p Chl^E_p with HydroLight's new Case 1 coefficients with
-    mid-ultraviolet absorption (AEmidUVabs.txt: 0.0736, 0.8524 at 300 nm; 0.0453, 0.7702 at
+    """Outside 400-700 nm a_p = A_p Chl^E_p with HydroLight's new Case 1 coefficients of
+    medium ultraviolet absorption (AEmidUVabs.txt: 0.0736, 0.8524 at 300 nm; 0.0453, 0.7702 at
     350 nm; 0.0002, 1 at 715 nm; 0 from 720 nm), continuous where it meets Bricaud's table at
     400 and 700 nm, continued below 300 nm with its own log-slope (never flat); a_ph at most
     a_p."""

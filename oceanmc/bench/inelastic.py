@@ -137,6 +137,34 @@ collision_density has just computed (37 exponentials, about 230 cycles by a micr
 instead of computing them again: outputs bit for bit, but no measurable gain (simulate() of
 10^5 photons, seven interleaved rounds of medians of 3: Raman alone 1.054 s against 1.023 s,
 the defaults 1.316 s against 1.332 s, medians; about 3% expected, under this machine's noise).
+
+Four more levers measured against the target (session 29, 2026-11-29, kernel 97f543c, this
+section's scene with Raman scattering alone, 10^5 photons, simulate() times, 4-6 seeds each;
+none kept, no code changed):
+- the carry made at a random fraction q of the collisions (the draw from the emissions'
+  stream; carried light weighs 1 / q; a scratch copy): the run 7% faster at q = 0.5 and 10% at
+  0.25, but the Raman part of Rrs(550)'s relative error grew from 0.41% to 0.56% and 0.81%
+  (its time to 1% 0.19 s against 0.31 s and 0.64 s): the light carried on is a large part of
+  the Raman part's variance, not a small correction;
+- a wider upward cone (estimator.upward_cone_deg 40 and 90 instead of 15): the Raman part of
+  Rrs(550) to 1% in 1.0 s and 3.5 s against 0.19 s (the elastic run's own Rrs(550) lost as
+  much: 0.41 s and 2.1 s against 0.067 s); Raman Eu(0-) gained 1.2x and 1.7x;
+- Russian roulette at weight 0.01 or 0.03 instead of 0.001 (estimator.roulette_weight): the
+  elastic run's Rrs(550) to 1% 0.055 s and 0.23 s against 0.065 s, the Raman part's 0.20 s and
+  0.28 s against 0.20 s: no lever for the ratio;
+- fewer or more heroes at the wavelengths added for the excitation (340-390 nm, 30% of the
+  heroes at hero_exponent 1, their shares scaled by 0.1, 0.3, 2 or 4): fewer made the run
+  slower (1.39 s and 2.19 s against 1.12 s: the visible heroes then carry the barely absorbed
+  ultraviolet light on long walks) and the Raman part of Rrs(550) noisier (0.46% against
+  0.41%), more no better (0.43-0.44%).
+A toy model of the emissions alone (one excitation and one emission wavelength, clear water,
+a photon's direct Raman score to the nadir) gave a track-length estimate of the emission along
+each free path (the collision estimate's expectation over where on the path the collision
+falls) 1/17 of the collision estimate's variance with the hero at the excitation wavelength,
+and nothing (1.33 against 1.42 per photon) with a hero attenuated three times as much. 69% of
+this scene's heroes are at 340-480 nm, of the first kind, but the direct emission is not
+where the Raman part's variance is: one point drawn along the unscattered beam (above) left it
+unchanged, and the carried light (the first item) holds much of it. Not built.
 """
 from __future__ import annotations
 

@@ -119,7 +119,8 @@ class ChlorophyllComponent(_Strict):
 class Case1Component(_Strict):
     """Case-1 water's every non-water IOP from chlorophyll alone, HydroLight's "new Case 1" model
     (optics/components/case1.py): particles (phytoplankton and covarying detritus) a_p = A_p
-    Chl^E_p (Bricaud et al. 1998; outside 400-700 nm HydroLight's mid-UV coefficients), CDOM
+    Chl^E_p (Bricaud et al. 1998; outside 400-700 nm HydroLight's coefficients of medium UV
+    absorption), CDOM
     0.2 a_p(440) exp(-0.014 (lambda - 440)), b_p = 0.416 Chl^0.766 (lambda/550)^nu and two
     particle populations with the bb/b of Morel et al. (2002).
     Pure water is its own component."""

@@ -500,7 +500,11 @@ def reference_walk(wavelengths_nm, depth_m, absorption, *, elastic=None, b488: f
 # J. Geophys. Res. Oceans 118, 4241-4255, Eq. 11: the Raman factor of an observed Rrs at a band,
 # RF = alpha Rrs(443) / Rrs(550) + beta1 Rrs(550)^beta2 (Rrs in 1/sr), the light without Raman
 # being Rrs / (1 + RF). Coefficients per band as NASA's l2gen applies them (src/l2gen/raman.c,
-# L. McKinna 2015), not checked against the paper's table: band (nm): (alpha, beta1, beta2)
+# L. McKinna 2015), not checked against the paper's table; the same 18 numbers in an
+# independent copy that cites the paper (GitHub kelseybisson/GIOP, single_wv_comps.m, commit
+# d195509; its band 555 for 551) and in NASA's l2gen copies (checked 2026-11-29); OceanOptics/
+# MISCToolbox's correct_Raman.m writes beta2 without its minus sign, which would make RF fall
+# in clearer water: band (nm): (alpha, beta1, beta2)
 LEE_2013 = {412.0: (0.003, 0.014, -0.022), 443.0: (0.004, 0.015, -0.023),
             488.0: (0.011, 0.010, -0.051), 531.0: (0.015, 0.010, -0.070),
             551.0: (0.017, 0.010, -0.080), 667.0: (0.018, 0.010, -0.081)}

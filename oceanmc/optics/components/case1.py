@@ -27,10 +27,10 @@ Backscatter: two populations (Morel et al. 2002): a share alpha = 0.855 (0.5 - 0
   small- and large-particle phase functions, which oceanmc does not ship; Fournier-Forand with
   the same bb/b is what oceanmc's other particle models use, Mobley et al. 2002).
 
-Beyond 400-700 nm (the range of the Bricaud table): HydroLight's own coefficients with
-mid-ultraviolet absorption (Mobley, Ocean Optics Web Book, the new Case 1 IOP model's
-AEmidUVabs.txt, 300-1000 nm: after Morrison & Nelson 2004 and Vasilkov et al. 2005 below 400 nm;
-0 from 720 nm; chlorophyll.particle_absorption), continued below 300 nm with the table's own
+Beyond 400-700 nm (the range of the Bricaud table): HydroLight's own coefficients for its
+medium choice of ultraviolet absorption (Mobley, Ocean Optics Web Book, the new Case 1 IOP
+model's AEmidUVabs.txt, 300-1000 nm: after Morrison & Nelson 2004 and Vasilkov et al. 2005
+below 400 nm; 0 from 720 nm; chlorophyll.particle_absorption), continued below 300 nm with the table's own
 log-slope. The living part, a_ph, is Bricaud's A_phi, E_phi with Vasilkov et al. (2005)'s
 ultraviolet shape (chlorophyll.phytoplankton_absorption), held at most a_p (at Chl below about
 0.002 mg/m3 the two tables would put it above a_p at 300 nm and below)."""

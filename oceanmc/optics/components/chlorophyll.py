@@ -30,8 +30,9 @@ EDGE_NM = 10.0
 
 
 def _particle_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
-    """A_p Chl^E_p at 300-1000 nm: Bricaud et al. (1998) inside 400-700 nm, HydroLight's mid-UV
-    coefficient file outside it (0 from 720 nm; beyond 1000 nm its last row, 0)."""
+    """A_p Chl^E_p at 300-1000 nm: Bricaud et al. (1998) inside 400-700 nm, HydroLight's
+    coefficient file of medium UV absorption (AEmidUVabs) outside it (0 from 720 nm; beyond
+    1000 nm its last row, 0)."""
     table, tails = packaged(BRICAUD), packaged(HYDROLIGHT_TAILS)
     below, above = tails["wavelength_nm"] < TABLE_LOW_NM, tails["wavelength_nm"] > TABLE_HIGH_NM
 
@@ -45,7 +46,7 @@ def _particle_table(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
 
 def particle_absorption(chl: float, wavelengths_nm: np.ndarray) -> np.ndarray:
     """a_p (1/m), all particles, Chl > 0: A_p Chl^E_p, Bricaud et al. (1998) at 400-700 nm and
-    HydroLight's new Case 1 model's coefficients with mid-ultraviolet absorption outside it
+    HydroLight's new Case 1 model's coefficients of medium ultraviolet absorption outside it
     (Mobley, Ocean Optics Web Book, AEmidUVabs.txt: 300-1000 nm, 0 from 720 nm), so that
     case1's particles are HydroLight's in the ultraviolet too; below 300 nm continued
     exponentially with the log-slope the table has over its first EDGE_NM (oceanmc's own rule:
