@@ -312,7 +312,7 @@ def cmd_show(args: argparse.Namespace) -> int:
     from .config.loading import file_problem
     from .run.derived import format_derived
     from .run.hdf5 import load_result
-    from .run.summary import format_summary
+    from .run.summary import format_iops, format_summary
 
     path = Path(args.file)
     problem = file_problem(path)
@@ -324,6 +324,8 @@ def cmd_show(args: argparse.Namespace) -> int:
         raise UsageError(f"{path}: {exc}") from None
     print(format_summary(result))
     print(format_derived(result))
+    if args.iops:
+        print(format_iops(result))
     if args.config:
         print(result.config_yaml)
     return 0
@@ -574,6 +576,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     show = sub.add_parser("show", help="print the summary of a results file")
     show.add_argument("file", metavar="RESULT.h5")
+    show.add_argument("--iops", action="store_true",
+                      help="also print the IOPs the run used, layer by layer")
     show.add_argument("--config", action="store_true", help="also print the stored scene")
     show.set_defaults(func=cmd_show)
 

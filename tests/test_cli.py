@@ -386,3 +386,29 @@ def test_resume_with_no_file_says_so_and_runs_from_the_start(tmp_path, scene_fil
     assert f"--resume: no file at fresh.h5 to continue; running {scene_file} from the start" \
         in done.stderr
     assert (tmp_path / "fresh.h5").is_file() and "budget total" in done.stdout
+
+
+def test_show_iops_prints_each_layer_s_iops_and_the_bottom(tmp_path, scene_file):
+    """`oceanmc show --iops`: the IOPs the run stored (group iops), layer by layer, with bb/b
+    and w0 = b/c computed from them, and the bottom's reflectance; a file without them says so."""
+    from oceanmc.run.result import Result
+    from oceanmc.run.summary import format_iops
+
+    iops = {"wavelength": np.array([400.0, 500.0]), "layer_top": np.array([0.0, 5.0]),
+            "layer_thickness": np.array([5.0, np.inf]),
+            "a": np.array([[0.1, 0.2], [0.3, 0.4]]), "b": np.array([[0.4, 0.5], [0.0, 0.6]]),
+            "bb": np.array([[0.008, 0.01], [0.0, 0.03]]),
+            "c": np.array([[0.5, 0.7], [0.3, 1.0]]), "bottom_reflectance": np.array([0.1, 0.2])}
+    text = format_iops(Result({}, {}, {}, None, iops))
+    lines = text.splitlines()
+    assert "2 layers" in lines[0]
+    assert lines[1].split(":")[1].strip() == "0 m to 5 m"
+    assert lines[3].split() == ["400", "0.1", "0.4", "0.008", "0.5", "0.02", "0.8"]
+    assert "5 m to infinite depth" in text
+    assert lines[7].split() == ["400", "0.3", "0", "0", "0.3", "nan", "0"]   # no scattering
+    assert lines[-1].split() == ["500", "0.2"] and "reflectance" in lines[-3]
+    assert "holds none" in format_iops(Result({}, {}, {}, None, {}))
+    # the command: a run's own file
+    assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0
+    done = oceanmc("show", "r.h5", "--iops", cwd=tmp_path)
+    assert done.returncode == 0 and "IOPs the run used (1 layer" in done.stdout, done.stderr

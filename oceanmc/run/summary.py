@@ -390,6 +390,43 @@ def data_file_lines(result: Result) -> list[str]:
                          break_on_hyphens=False, break_long_words=False)
 
 
+def format_iops(result: Result) -> str:
+    """The IOPs the run used (the file's group iops) as text for `oceanmc show --iops`: per
+    layer, a table by wavelength of a, b, bb, c (1/m), bb/b and the single-scattering albedo
+    w0 = b/c, and the bottom's reflectance where it has one; a layer of a depth profile is one
+    of the homogeneous sublayers the run traced."""
+    iops = result.iops
+    if not iops:
+        return "  IOPs: this file holds none (it was written before oceanmc stored them)"
+    wavelengths = np.atleast_1d(iops["wavelength"])
+    tops, thicknesses = iops["layer_top"], iops["layer_thickness"]
+    lines = [f"  IOPs the run used ({len(tops)} layer{'s' if len(tops) > 1 else ''}; the "
+             "file's group iops), 1/m:"]
+
+    def table(headings: list[str], columns: list[np.ndarray]) -> list[str]:
+        rows = [f"  {'nm':>6}" + "".join(f"{h:>{IOP_CELL}}" for h in headings)]
+        for k, wavelength in enumerate(wavelengths):
+            nm = f"{wavelength:>6g}" if np.isfinite(wavelength) else f"{'-':>6}"
+            rows.append(f"  {nm}" + "".join(f"{column[k]:>{IOP_CELL}.5g}" for column in columns))
+        return rows
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for i, (top, thickness) in enumerate(zip(tops, thicknesses)):
+            a, b, bb, c = (np.atleast_1d(iops[name][i]) for name in ("a", "b", "bb", "c"))
+            bottom = f"{top + thickness:g} m" if np.isfinite(thickness) else "infinite depth"
+            lines.append(f"  layer {i + 1}: {top:g} m to {bottom}")
+            lines += table(["a", "b", "bb", "c", "bb/b", "w0 = b/c"],
+                           [a, b, bb, c, np.where(b > 0.0, bb / b, np.nan),
+                            np.where(c > 0.0, b / c, np.nan)])
+    if "bottom_reflectance" in iops:
+        lines.append("  bottom")
+        lines += table(["reflectance"], [np.atleast_1d(iops["bottom_reflectance"])])
+    return "\n".join(lines)
+
+
+# a column of `oceanmc show --iops`: a value to 5 significant digits (1.2345e-05) and its gap
+IOP_CELL = 13
+
+
 def format_summary(result: Result) -> str:
     a = result.attrs
     lines = [
