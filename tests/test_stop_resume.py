@@ -205,6 +205,30 @@ def test_spectral_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_scen
                          resume_state=part.resume_state)
 
 
+def test_inelastic_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_scene, monkeypatch):
+    """A run with inelastic light stopped mid-batch: its file (each part's unfinished tallies in
+    a group of their own, resume/tally/part1/...) loads, shows and resumes bit for bit. (It was
+    refused as 'not an oceanmc results file' until the reader went into those groups.)"""
+    small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 500.0, 550.0],
+                       water=dict(small_scene["water"], inelastic={"raman": {}}))
+    full = oceanmc.simulate(small_scene, threads=2)
+    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
+    assert part.attrs["partial"] and part.resume_state is not None
+    out = tmp_path / "p.h5"
+    part.save(out)
+    with h5py.File(out, "r") as f:
+        assert "flux" in f["resume/tally/part1"]
+    part = load_result(out)
+    assert "tally/part1/flux" in part.resume_state
+    shown = subprocess.run([sys.executable, "-m", "oceanmc", "show", str(out)],
+                           capture_output=True, text=True, env=ENV)
+    assert shown.returncode == 0 and "PARTIAL: 0 of 2" in shown.stdout, shown.stderr
+    rest = oceanmc.simulate(small_scene, threads=2, resume_state=part.resume_state)
+    done = merge_results([part, rest], resume=True)
+    for name, q in full.quantities.items():
+        assert np.array_equal(done.quantities[name].batches, q.batches), name
+
+
 @pytest.mark.parametrize("with_layout", [False, True])
 def test_raw_tally_rows_of_an_earlier_oceanmc_are_refused(tmp_path, small_scene, monkeypatch,
                                                           with_layout):

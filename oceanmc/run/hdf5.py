@@ -64,6 +64,20 @@ def _dataset(group: h5py.Group, name: str, kind: str = "fc") -> np.ndarray:
     return obj[()]
 
 
+def _datasets_within(group: h5py.Group, prefix: str = "") -> dict[str, np.ndarray]:
+    """Every dataset under `group` by its path below it (a run with inelastic light keeps each
+    part's tally arrays in a group of its own: part1/flux, ...), refusing links as _dataset
+    does."""
+    out = {}
+    for name in group:
+        link = group.get(name, getlink=True)
+        if isinstance(link, h5py.HardLink) and isinstance(group[name], h5py.Group):
+            out.update(_datasets_within(group[name], f"{prefix}{name}/"))
+        else:
+            out[prefix + name] = _dataset(group, name)
+    return out
+
+
 def _read(f: h5py.File) -> Result:
     attrs = {k: _plain(v) for k, v in f.attrs.items() if k != "format_version"}
     for key in ("config_yaml", "batches"):
@@ -102,7 +116,8 @@ def _read_resume(group: h5py.Group) -> dict[str, np.ndarray]:
     state = {name: _dataset(group, name, "fciu") for name in RESUME_FIELDS}
     if isinstance(group.get("tally", getlink=True), h5py.HardLink) \
             and isinstance(group["tally"], h5py.Group):
-        state.update({f"tally/{name}": _dataset(group["tally"], name) for name in group["tally"]})
+        state.update({f"tally/{name}": values
+                      for name, values in _datasets_within(group["tally"]).items()})
     else:
         # an earlier oceanmc's raw tally rows, whose layout cannot be known: kept as stored,
         # so that check_resumable refuses to continue them (the whole batches stay readable)
