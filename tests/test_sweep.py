@@ -655,3 +655,33 @@ def test_a_wavelength_added_for_the_excitation_outside_a_table_is_said_to_be_one
     assert "water.layers[0].components[0].absorption_file: wavelength " in message, message
     assert "(traced for the excitation of water.inelastic, which adds " in message, message
     assert not (tmp_path / "lut.points").exists()
+
+
+PACK_SCRIPT = """
+import hashlib, sys, yaml
+from oceanmc import scene
+from oceanmc.config import load_config
+packed = scene.build(load_config(yaml.safe_load(sys.stdin.read())))
+print(hashlib.sha256(packed.floats.tobytes() + packed.ints.tobytes()).hexdigest())
+"""
+
+
+def test_a_packed_scene_does_not_depend_on_blas_threads():
+    """A sweep's Dask workers run BLAS on one thread, `oceanmc run` on every core; a scene must
+    pack to the same numbers either way, or a point is not its single run bit for bit. An
+    inelastic scene (the transfers) under a rough sea and a Harrison-Coombes sky: BLAS products
+    on one and two OpenBLAS threads differed in the last bit of its transfers, until the
+    packing summed them with numpy's own loops."""
+    config = yaml.safe_load((REPO / "configs" / "raman_fluorescence.yaml").read_text())
+    config["water"]["inelastic"]["cdom_fluorescence"] = {}
+    config["surface"] = {"model": "cox_munk", "wind_speed_m_s": 5.0}
+    config["illumination"]["sky"] = "harrison_coombes"
+    digests = set()
+    for threads in ("1", "2", "4"):
+        env = dict(ENV, OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads,
+                   MKL_NUM_THREADS=threads)
+        done = subprocess.run([sys.executable, "-c", PACK_SCRIPT], input=yaml.safe_dump(config),
+                              capture_output=True, text=True, env=env, cwd=REPO / "configs")
+        assert done.returncode == 0, done.stderr
+        digests.add(done.stdout.strip())
+    assert len(digests) == 1

@@ -95,7 +95,9 @@ def _sum_of(parts: list[Contribution], name: str) -> np.ndarray | None:
 
 def _layer(part: Contribution, top: float, thickness: float, index: int) -> LayerIOPs:
     fractions = np.array([backscatter_fraction(p) for p in part.phases])
-    return LayerIOPs(top, thickness, part.a, part.b, part.b * (part.weights @ fractions),
+    # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
+    return LayerIOPs(top, thickness, part.a, part.b,
+                     part.b * np.einsum("...k,k->...", part.weights, fractions),
                      part.phases, part.weights, index, part.a_phytoplankton, part.a_cdom)
 
 

@@ -59,7 +59,10 @@ def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0
         cos_psi = s * np.cos(phi)[None, :] * sun[0] + mu[:, None] * sun[2]
         integral = (sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]
                     ).sum() * (1.0 / 400) * (2.0 * math.pi / 720)
-        return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2], dirs @ sun, cos_sun)
+        # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
+        return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2],
+                                                           np.einsum("dk,k->d", dirs, sun),
+                                                           cos_sun)
     return None
 
 

@@ -84,7 +84,17 @@ def transfer(process, settings, wavelengths_nm: np.ndarray, sigma_shape: np.ndar
     f = process.redistribution(settings, fine, wl)            # (n_fine, n_emi) 1/nm
     energy = fine[:, None] / wl[None, :]                      # l' / l_i
     integrand = (sigma_fine * weights)[:, None] * energy * f  # (n_fine, n_emi)
-    out = hat @ integrand                                     # (n_exc, n_emi)
+    # (n_exc, n_emi), each row over its hat's support, by numpy's own loops, never BLAS, as
+    # everything a scene packs: a BLAS product's sums depend on its thread count (OpenBLAS on
+    # one thread and on two differed in the last bit here, so a sweep's Dask workers, whose
+    # BLAS runs on one, did not reproduce a single run of the same point bit for bit; a user's
+    # review, 2026-11-29)
+    out = np.zeros((len(wl), integrand.shape[1]))
+    for j, row in enumerate(hat):
+        support = np.flatnonzero(row)
+        if len(support):
+            part = slice(support[0], support[-1] + 1)
+            out[j] = np.einsum("f,fi->i", row[part], integrand[part])
     per_sigma = np.divide(1.0, sigma_shape, out=np.zeros_like(sigma_shape),
                           where=sigma_shape > 0.0)
     out *= per_sigma[:, None] * ed0[:, None] / ed0[None, :]

@@ -87,7 +87,9 @@ def shape_integral(excitation_nm: np.ndarray) -> np.ndarray:
     u = low + half * (x[None, :] + 1.0)
     centre, width = _centre_and_width(exc[:, None])
     integrand = np.exp(-((u - centre) / width) ** 2) / (u * u)
-    return np.where(exc < CDOM_EMISSION_MAX_NM, (half * integrand) @ weights, 0.0)
+    # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
+    return np.where(exc < CDOM_EMISSION_MAX_NM, np.einsum("ek,k->e", half * integrand, weights),
+                    0.0)
 
 
 def quantum_yield(settings, excitation_nm: np.ndarray) -> np.ndarray:
