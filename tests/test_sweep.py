@@ -685,3 +685,34 @@ def test_a_packed_scene_does_not_depend_on_blas_threads():
         assert done.returncode == 0, done.stderr
         digests.add(done.stdout.strip())
     assert len(digests) == 1
+
+
+def test_points_that_trace_other_wavelengths_share_the_union_grid(tmp_path, thread_client):
+    """An axis that switches Raman scattering on changes the wavelengths a point traces for the
+    excitation (it crashed the dataset's assembly after every point had run): the dataset's
+    grid is every wavelength some point traces, NaN where a point did not, and
+    wavelength_traced says per point which were asked for (1), added for the excitation (2)
+    or not traced (0); each point's values are its single run's."""
+    base = copy.deepcopy(TINY)
+    base["wavelengths_nm"] = [450.0, 500.0]
+    base["water"] = {"layers": [{"thickness_m": 2.0, "components": [
+        {"model": "pure_water"}, {"model": "case1", "chl_mg_m3": 0.5}]}]}
+    axis = {"water.inelastic": [None, {"raman": {}}]}
+    ds = oceanmc.sweep(sweep_file(tmp_path, axis, base=base), tmp_path / "lut.nc",
+                       client=thread_client, threads=1)
+    assert list(ds["status"].values) == ["done", "done"]
+    grid = ds["wavelength"].values
+    assert grid[0] < 400.0 and grid[-1] == 500.0 and list(grid).count(450.0) == 1
+    flags = ds["wavelength_traced"].values
+    asked = np.isin(grid, [450.0, 500.0])
+    assert (flags[0] == np.where(asked, 1, 0)).all()
+    assert (flags[1] == np.where(asked, 1, 2)).all()
+    rrs = ds["air_Rrs_nadir"].values
+    assert np.isnan(rrs[0, ~asked]).all() and np.isfinite(rrs[1]).all()
+    for k, inelastic in enumerate(axis["water.inelastic"]):
+        scene = copy.deepcopy(base)
+        if inelastic is not None:
+            scene["water"]["inelastic"] = inelastic
+        single = oceanmc.simulate(scene, threads=1)
+        traced = flags[k] > 0
+        assert np.array_equal(rrs[k, traced], single["air/Rrs_nadir"]), k

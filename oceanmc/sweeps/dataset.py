@@ -8,7 +8,9 @@ keys of a zip group are coordinates along it), then each quantity's own dimensio
 every quantity X of the results file (`air/Rrs_nadir` becomes `air_Rrs_nadir`, `budget/total`
 `budget_total`, the derived `Kd` `derived_Kd`, along depth_interval with depth_upper and
 depth_lower) with `X_stderr` beside it; per point `status` (done, failed, pending), `error`,
-`photons` and `wall_time_s`; the base scene and the sweep in the attributes."""
+`photons` and `wall_time_s`; the base scene and the sweep in the attributes. The wavelength
+grid is every wavelength some point traces, with `wavelength_traced` per point (wavelength_grid:
+inelastic light makes points trace other grids)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -154,6 +156,9 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
                 coords[name] = ("depth_interval", values, _coord_attrs(name))
             elif name not in coords:
                 coords[name] = (name, values, _coord_attrs(name))
+    grid, places, traced = wavelength_grid(points, shape)
+    if grid is not None:
+        coords["wavelength"] = ("wavelength", grid, _coord_attrs("wavelength"))
     arrays: dict[str, tuple] = {}
     for point in points:
         summary = summaries.get(point.key)
@@ -165,16 +170,28 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
         photons[point.index] = summary.photons
         wall[point.index] = summary.wall_time_s
         for name, (qdims, mean, stderr, units, description) in summary.quantities.items():
+            spectral = grid is not None and qdims[:1] == ("wavelength",)
             if name not in arrays:
-                arrays[name] = (qdims, np.full(shape + mean.shape, np.nan),
-                                np.full(shape + mean.shape, np.nan), units, description)
-            arrays[name][1][point.index] = mean
-            arrays[name][2][point.index] = stderr
+                size = (len(grid),) + mean.shape[1:] if spectral else mean.shape
+                arrays[name] = (qdims, np.full(shape + size, np.nan),
+                                np.full(shape + size, np.nan), units, description)
+            # a point's wavelengths in their places on the sweep's grid (NaN at the others)
+            at = point.index + (places[point.key],) if spectral else point.index
+            arrays[name][1][at] = mean
+            arrays[name][2][at] = stderr
     for name, (qdims, mean, stderr, units, description) in arrays.items():
         var = variable_name(name)
         data[var] = (dims + qdims, mean, {"units": units, "description": description})
         data[var + "_stderr"] = (dims + qdims, stderr,
                                  {"units": units, "description": f"standard error of {var}"})
+    if grid is not None:
+        data["wavelength_traced"] = (dims + ("wavelength",), traced, {
+            "flag_values": np.array([0, 1, 2], dtype=np.int8),
+            "flag_meanings": "not_traced asked added_for_the_excitation",
+            "description": "how the point traced each wavelength: 0 not at all (its quantities "
+                           "NaN there), 1 asked for (wavelengths_nm), 2 added for the "
+                           "excitation of its inelastic light (without the inelastic light "
+                           "excited below the point's grid)"})
     data["status"] = (dims, status.astype(str), {"description": "done, failed or pending "
                                                  "(not run yet: an interrupted sweep)"})
     data["error"] = (dims, error.astype(str), {"description": "why a failed point failed"})
@@ -194,6 +211,38 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
         "partial": int(counts[PENDING] > 0),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+NOT_TRACED, ASKED, ADDED = 0, 1, 2
+
+
+def wavelength_grid(points: list[Point], shape: tuple[int, ...]
+                    ) -> tuple[np.ndarray | None, dict[str, np.ndarray], np.ndarray | None]:
+    """The sweep's wavelength grid, every wavelength some point traces (points whose inelastic
+    light needs other excitation wavelengths trace other grids: an axis that switches Raman
+    scattering on, or moves an excitation range), each point's places on it by key, and per
+    point and wavelength the flag wavelength_traced (NOT_TRACED, ASKED, ADDED); (None, {},
+    None) for monochromatic points."""
+    traced = {p.key: np.asarray(p.config.wavelengths, dtype=np.float64) for p in points}
+    if not points or any(np.isnan(w).any() for w in traced.values()):
+        return None, {}, None
+    # one value per wavelength however each grid was computed (400 and 400.00000000000006)
+    merged = np.unique(np.concatenate(list(traced.values())))
+    keep = np.concatenate([[True], np.diff(merged) > WAVELENGTH_MATCH_NM])
+    grid = merged[keep]
+    places = {key: np.abs(grid[None, :] - w[:, None]).argmin(axis=1)
+              for key, w in traced.items()}
+    flags = np.full(shape + (len(grid),), NOT_TRACED, dtype=np.int8)
+    for point in points:
+        flags[point.index + (places[point.key],)] = ASKED
+        added = np.asarray(point.config.added_wavelengths, dtype=np.float64)
+        if len(added):
+            flags[point.index + (np.abs(grid[None, :] - added[:, None]).argmin(axis=1),)] = ADDED
+    return grid, places, flags
+
+
+# two traced wavelengths closer than this are one (grids are computed, not typed)
+WAVELENGTH_MATCH_NM = 1e-6
 
 
 def _coord_attrs(name: str) -> dict:
