@@ -322,7 +322,8 @@ def _axes(spec: Any) -> tuple[Axis, ...]:
 # or RESERVED_NAMES)
 RESERVED_NAMES = frozenset({
     "depth", "theta", "phi", "theta_edges", "phi_edges", "direction", "direction_theta",
-    "direction_phi", "wavelength", "status", "error", "photons", "wall_time_s", "zip",
+    "direction_phi", "wavelength", "wavelength_traced", "status", "error", "photons",
+    "wall_time_s", "zip",
     "Ed", "Eu", "Eod", "Eou", "Eo", "Lu", "Lu_crossing", "local_radiance", "radiance"})
 RESERVED_PREFIXES = ("air_", "budget_")
 _ALIAS = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
