@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 
 import oceanmc
 from oceanmc import optics
@@ -95,3 +96,21 @@ def test_flat_spectrum_is_todays_illumination():
     ed0, diffuse, zenith = optics.illumination_spectrum(
         scene({"Ed0": 2.0, "diffuse_fraction": 0.25, "sun_zenith_deg": 40.0}))
     assert ed0.tolist() == [2.0] * 4 and diffuse.tolist() == [0.25] * 4 and zenith == 40.0
+
+
+def test_column_iops_and_the_illumination_take_a_scene_as_simulate_does(tmp_path):
+    """README: column_iops and illumination_spectrum take a dict, a YAML path or a SceneConfig
+    (a dict raised AttributeError before), and LayerIOPs has top_m and thickness_m."""
+    from oceanmc.config import load_config
+    from oceanmc.optics import column_iops, illumination_spectrum
+    scene = {"wavelengths_nm": [450.0, 550.0], "illumination": {"sun_zenith_deg": 30},
+             "water": {"layers": [{"thickness_m": 5.0, "components": [
+                 {"model": "pure_water"}, {"model": "case1", "chl_mg_m3": 0.3}]}]},
+             "bottom": {"model": "lambertian", "reflectance": 0.1}}
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    layers = [column_iops(given) for given in (scene, path, load_config(scene))]
+    for other in layers[1:]:
+        assert np.array_equal(other[0].a, layers[0][0].a)
+    assert layers[0][0].top_m == 0.0 and layers[0][0].thickness_m == 5.0
+    assert np.array_equal(illumination_spectrum(scene)[0], illumination_spectrum(path)[0])

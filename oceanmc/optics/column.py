@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -231,9 +232,12 @@ def _constituent_layers(layer: cfg.Layer, top: float, wl: np.ndarray, index: int
     return out
 
 
-def column_iops(config: cfg.SceneConfig) -> list[LayerIOPs]:
+def column_iops(config: cfg.SceneConfig | dict | str | Path) -> list[LayerIOPs]:
     """The layers top to bottom, each homogeneous; the last may be infinitely deep. Raman
-    scattering's loss (optics/inelastic/raman.py) is in every layer's absorption."""
+    scattering's loss (optics/inelastic/raman.py) is in every layer's absorption. config: a
+    SceneConfig, or what load_config reads (a dict, a YAML path), as simulate() takes it."""
+    if not isinstance(config, cfg.SceneConfig):
+        config = cfg.load_config(config)
     wl = config.wavelengths
     out: list[LayerIOPs] = []
     top = 0.0

@@ -2,6 +2,8 @@
 (config/illumination.py: spectrum flat, spectrl2 or table; sun_zenith_deg or sun_position)."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from .. import config as cfg
@@ -42,8 +44,12 @@ def spectrl2(spectrum: cfg.Illumination, zenith_deg: float, day_of_year: int | N
     return ed0, np.divide(sky, ed0, out=np.zeros_like(sky), where=ed0 > 0.0)
 
 
-def illumination_spectrum(config: cfg.SceneConfig) -> tuple[np.ndarray, np.ndarray, float]:
-    """(Ed0 (n_wl,), diffuse_fraction (n_wl,), sun_zenith_deg)."""
+def illumination_spectrum(config: cfg.SceneConfig | dict | str | Path
+                          ) -> tuple[np.ndarray, np.ndarray, float]:
+    """(Ed0 (n_wl,), diffuse_fraction (n_wl,), sun_zenith_deg). config: a SceneConfig, or what
+    load_config reads (a dict, a YAML path)."""
+    if not isinstance(config, cfg.SceneConfig):
+        config = cfg.load_config(config)
     wl = config.wavelengths
     light = config.illumination
     spectrum = light.spectrum
