@@ -202,8 +202,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     overrides = {"photons": args.photons, "seed": args.seed}
 
     def config_error(path: Path, exc: ConfigError) -> int:
-        print(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
-              else f"oceanmc: config error: {exc}", file=sys.stderr)
+        print(one_line(f"oceanmc: config error: {path}: {exc}" if str(path) not in str(exc)
+                       else f"oceanmc: config error: {exc}"), file=sys.stderr)
         return 2
 
     # every config is checked, and each bad one named, before any is run
@@ -259,7 +259,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             # a file this run's checkpoints made before the fault showed is not left as if the
             # scene had run well
             output.discard()
-            print(f"oceanmc: error: {path}: {exc}", file=sys.stderr)
+            print(one_line(f"oceanmc: error: {path}: {exc}"), file=sys.stderr)
             return 3
         result.attrs["config_file"] = str(path)
         output.save(result)
@@ -655,13 +655,20 @@ def _non_negative_int(text: str) -> int:
     return value
 
 
+def one_line(text: str) -> str:
+    """An error message as one line: a character that is not printable (a line break in a file
+    name given to -o, say) written as its escape, as repr() writes it."""
+    return text if text.isprintable() else "".join(
+        c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return args.func(args)
     except UsageError as exc:
-        print(f"oceanmc: error: {exc}", file=sys.stderr)
+        print(one_line(f"oceanmc: error: {exc}"), file=sys.stderr)
         return 2
     except BrokenPipeError:   # before OSError, its base: `oceanmc show x.h5 | head` is fine
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -669,7 +676,7 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         if not hasattr(exc, "kept"):  # run.placement.ResultsSavedElsewhere
             raise
-        print(f"oceanmc: error: {exc}", file=sys.stderr)
+        print(one_line(f"oceanmc: error: {exc}"), file=sys.stderr)
         return 1 if "no space" in exc.reason else 2
     except KeyboardInterrupt:
         print("oceanmc: interrupted; no partial results file was written", file=sys.stderr)

@@ -176,6 +176,22 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
                                                       "latitude": 1, "longitude": 2}),
      "config: illumination.sun_position.latitude: unknown key; did you mean latitude_deg? "
      "(and 1 more problem)"),
+    # a value of the wrong form at a key of one form: that form in words, not pydantic's
+    # Python types ('a valid tuple', 'a valid dictionary or instance of Inelastic')
+    (lambda s: s["tallies"].update(local_directions_deg=[180, 0]),
+     "config: tallies.local_directions_deg[0] = 180: expected a list of 2 numbers (and 1 more "
+     "problem)"),
+    (lambda s: s["water"].update(inelastic=["raman"]),
+     "config: water.inelastic = ['raman']: expected a mapping of its keys (raman, "
+     "chlorophyll_fluorescence, cdom_fluorescence, max_step_nm)"),
+    (lambda s: s["water"].update(inelastic={"chlorophyll_fluorescence": {
+        "excitation_range_nm": 400}}),
+     "config: water.inelastic.chlorophyll_fluorescence.excitation_range_nm = 400: expected a "
+     "list of 2 numbers"),
+    (lambda s: s.update(bottom="lambertian"),
+     "config: bottom = 'lambertian': expected a mapping {model: ..., ...} with model one of "
+     "none, black, lambertian, minnaert, specular, lambertian_specular, ggx, hapke, table, "
+     "mixture"),
 ])
 def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
         small_scene, change, message):

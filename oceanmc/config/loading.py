@@ -426,8 +426,11 @@ def _describe(error: dict) -> str:
     else:
         allowed = _allowed_range(error) or (" or ".join(forms) if kind in _WRONG_FORM
                                             and len(forms) > 1 else "")
+        expected = _expected_form(loc) if kind in _WRONG_FORM and not allowed else ""
         if allowed:
             msg = f"allowed: {allowed}"
+        elif expected:
+            msg = f"expected {expected}"
     if "input" in error and not isinstance(error["input"], dict):
         shown = _shown(error["input"])
         if len(shown) > 80:
@@ -462,6 +465,35 @@ def _allowed_range(error: dict) -> str:
 # refused)
 _WRONG_FORM = frozenset({"list_type", "tuple_type", "literal_error", "dict_type", "model_type",
                          "model_attributes_type"})
+
+
+def _expected_form(loc: tuple) -> str:
+    """For a value of the wrong form at a key of one form (`raman: on`, `excitation_range_nm:
+    400`): that form in words, a mapping with its keys or a list of so many numbers
+    (pydantic names a Python type: 'a valid dictionary or instance of Raman', 'a valid
+    tuple'); '' where the schema gives no one form."""
+    forms, models = [], {}
+    for annotation in _annotations_at(loc) or []:
+        for member, _ in _alternatives(annotation):
+            bare = _bare(member)
+            items = [a for a in get_args(bare) if a is not Ellipsis]
+            if get_origin(bare) is tuple and Ellipsis not in get_args(bare):
+                numbers = all(_bare(a) in (int, float) for a in items)
+                forms.append(f"a list of {len(items)} {'numbers' if numbers else 'values'}")
+            elif get_origin(bare) in (list, tuple):
+                forms.append("a list")
+            elif isinstance(bare, type) and issubclass(bare, BaseModel):
+                forms.append(f"a mapping of its keys ({', '.join(bare.model_fields)})")
+                for key in DISCRIMINATORS:   # a member chosen by its model (or profile)
+                    if key in bare.model_fields:
+                        models.setdefault(key, []).extend(
+                            get_args(bare.model_fields[key].annotation))
+    if len(forms) > 1 and len(models) == 1 and len(forms) == len(next(iter(models.values()))):
+        # a union of models chosen by one key, each of one value: name that key's values
+        (key, values), = models.items()
+        return (f"a mapping {{{key}: ..., ...}} with {key} one of "
+                f"{', '.join(dict.fromkeys(map(str, values)))}")
+    return " or ".join(forms) if len(forms) == 1 else ""
 
 
 def _union_forms(loc: tuple) -> list[str]:
