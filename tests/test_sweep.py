@@ -195,6 +195,10 @@ def test_an_axis_of_exponent_numbers_is_a_numeric_coordinate(tmp_path):
       "zip": {"a": {"key": "water.layers[0].a", "values": [0.1]}, "water.layers[0].b": [0.1]}},
      r"a: the name is given twice \(bottom.reflectance and water.layers\[0\].a\)"),
     ({"chl": {"key": "bottom..reflectance", "values": [0.1]}}, "is not a key path"),
+    # a misspelt key of the named form: that form, the key and the nearest one (it said
+    # "expected a list of values or one of {linspace ...}")
+    ({"chl": {"kee": "bottom.reflectance", "values": [0.1]}},
+     "a named axis is {key: KEY.PATH, values: \\[...\\]}; unknown key 'kee'; did you mean key\\?"),
 ])
 def test_a_bad_short_axis_name_is_refused_in_one_line(tmp_path, axes, message):
     with pytest.raises(SweepError, match=message):
@@ -346,6 +350,12 @@ def test_sweep_options_of_the_python_api_are_checked_as_the_command_checks_them(
     (name, value), = option.items()
     with pytest.raises(SweepError, match=rf"^{name} = {value!r}: expected an integer >= 1$"):
         oceanmc.sweep(sweep_file(tmp_path, {"bottom.reflectance": [0.1]}), **option)
+
+
+def test_a_misspelt_top_level_key_names_the_nearest(tmp_path):
+    with pytest.raises(SweepError, match=r"sweep: batch_group: unknown key; did you mean "
+                                         r"batch_groups\? \(allowed: base, set, axes"):
+        load_sweep(sweep_file(tmp_path, {"bottom.reflectance": [0.1]}, batch_group=2))
 
 
 def test_a_sweep_without_axes_is_one_point_and_exits_0(tmp_path):

@@ -225,9 +225,10 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     if not isinstance(data, dict):
         raise SweepError(f"sweep: the top level must be a mapping with keys {', '.join(SWEEP_KEYS)}"
                          f", got {type(data).__name__}")
-    unknown = sorted(set(data) - set(SWEEP_KEYS))
+    unknown = sorted(set(map(str, data)) - set(SWEEP_KEYS))
     if unknown:
-        raise SweepError(f"sweep: {unknown[0]}: unknown key; allowed: {', '.join(SWEEP_KEYS)}")
+        raise SweepError(f"sweep: {unknown[0]}: unknown key{_nearest(unknown[0], SWEEP_KEYS)} "
+                         f"(allowed: {', '.join(SWEEP_KEYS)})")
     base, base_dir = _base_scene(data.get("base"), folder)
     settings = data.get("set") or {}
     if not isinstance(settings, dict):
@@ -333,12 +334,13 @@ ALIAS_KEYS = ("key", "values")
 def _entry(name: str, spec: Any) -> tuple[str, str | None, tuple[Any, ...]]:
     """(key path, short name or None, values) of one axis entry: `KEY.PATH: VALUES` or
     `NAME: {key: KEY.PATH, values: VALUES}` (the dimension or coordinate then named NAME)."""
-    if isinstance(spec, dict) and "key" in spec:
+    if isinstance(spec, dict) and ("key" in spec or "values" in spec):
         unknown = sorted(set(map(str, spec)) - set(ALIAS_KEYS))
-        if unknown or "values" not in spec:
+        missing = [key for key in ALIAS_KEYS if key not in spec]
+        if unknown or missing:
             raise SweepError(f"axes: {name}: a named axis is {{key: KEY.PATH, values: [...]}}; "
-                             + (f"unknown key {unknown[0]!r}" if unknown
-                                else "values is missing"))
+                             + (f"unknown key {unknown[0]!r}{_nearest(unknown[0], ALIAS_KEYS)}"
+                                if unknown else f"{missing[0]} is missing"))
         if not isinstance(name, str) or not _ALIAS.match(name):
             raise SweepError(f"axes: {name!r}: a short axis name is letters, digits and _ "
                              "(not starting with a digit), e.g. chl; it names the dataset's "
@@ -352,6 +354,12 @@ def _entry(name: str, spec: Any) -> tuple[str, str | None, tuple[Any, ...]]:
         return path, name, _values(f"{name}.values", spec["values"])
     parse_key_path(name)
     return name, None, _values(name, spec)
+
+
+def _nearest(key: str, allowed) -> str:
+    """'; did you mean X?' for a misspelt key close to an allowed one, else ''."""
+    close = difflib.get_close_matches(key, list(allowed), n=1)
+    return f"; did you mean {close[0]}?" if close else ""
 
 
 def _zip_axis(group: Any) -> Axis:
