@@ -182,24 +182,31 @@ def test_tally_arrays_round_trip_exactly():
         write_tally_arrays(sc.grid, dict(arrays, cap=arrays["cap"][..., :2]), rebuilt)
 
 
+def stopped_saved_and_resumed(scene, monkeypatch, tmp_path):
+    """The scene stopped mid-batch, its partial file saved and loaded, and the run resumed from
+    it: every batch bit for bit the uninterrupted run's. Returns (the file, its Result)."""
+    full = oceanmc.simulate(scene, threads=2)
+    part = stopped_run(scene, monkeypatch, 0.001, 0)
+    assert part.attrs["partial"] and part.resume_state is not None
+    out = tmp_path / "p.h5"
+    part.save(out)
+    part = load_result(out)
+    rest = oceanmc.simulate(scene, threads=2, resume_state=part.resume_state)
+    done = merge_results([part, rest], resume=True)
+    for name, q in full.quantities.items():
+        assert np.array_equal(done.quantities[name].batches, q.batches), name
+    return out, part
+
+
 def test_spectral_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_scene, monkeypatch):
     """A spectral run stopped mid-batch resumes bit for bit from its file (the unfinished
     batches' tallies stored as named arrays, resume/tally/<name>); a scene whose tallies have
     another shape is refused."""
     small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 550.0, 650.0])
-    full = oceanmc.simulate(small_scene, threads=2)
-    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
-    assert part.attrs["partial"] and part.resume_state is not None
-    out = tmp_path / "p.h5"
-    part.save(out)
+    out, part = stopped_saved_and_resumed(small_scene, monkeypatch, tmp_path)
     with h5py.File(out, "r") as f:
         assert sorted(f["resume/tally"]) == ["budget", "cap", "flux", "local", "radiance"]
         assert f["resume/tally/flux"].shape[-1] == 3   # wavelength last
-    part = load_result(out)
-    rest = oceanmc.simulate(small_scene, threads=2, resume_state=part.resume_state)
-    done = merge_results([part, rest], resume=True)
-    for name, q in full.quantities.items():
-        assert np.array_equal(done.quantities[name].batches, q.batches), name
     with pytest.raises(ValueError, match="tallies do not fit this scene: tally flux is"):
         oceanmc.simulate(dict(small_scene, tallies={"depths_m": [0, 1]}),
                          resume_state=part.resume_state)
@@ -211,22 +218,13 @@ def test_inelastic_run_stopped_mid_batch_resumes_bit_for_bit(tmp_path, small_sce
     refused as 'not an oceanmc results file' until the reader went into those groups.)"""
     small_scene.update(photons=20000, batches=2, wavelengths_nm=[450.0, 500.0, 550.0],
                        water=dict(small_scene["water"], inelastic={"raman": {}}))
-    full = oceanmc.simulate(small_scene, threads=2)
-    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
-    assert part.attrs["partial"] and part.resume_state is not None
-    out = tmp_path / "p.h5"
-    part.save(out)
+    out, part = stopped_saved_and_resumed(small_scene, monkeypatch, tmp_path)
     with h5py.File(out, "r") as f:
         assert "flux" in f["resume/tally/part1"]
-    part = load_result(out)
     assert "tally/part1/flux" in part.resume_state
     shown = subprocess.run([sys.executable, "-m", "oceanmc", "show", str(out)],
                            capture_output=True, text=True, env=ENV)
     assert shown.returncode == 0 and "PARTIAL: 0 of 2" in shown.stdout, shown.stderr
-    rest = oceanmc.simulate(small_scene, threads=2, resume_state=part.resume_state)
-    done = merge_results([part, rest], resume=True)
-    for name, q in full.quantities.items():
-        assert np.array_equal(done.quantities[name].batches, q.batches), name
 
 
 @pytest.mark.parametrize("with_layout", [False, True])
