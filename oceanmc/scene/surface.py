@@ -66,6 +66,47 @@ def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0
     return None
 
 
+# directions per quad, along mu and along phi, over which sky_quad_radiance averages a sky
+QUAD_SAMPLES = 24
+
+
+def sky_quad_radiance(ill: cfg.Illumination, theta_edges: np.ndarray, phi_edges: np.ndarray,
+                      is_cap: np.ndarray) -> np.ndarray | None:
+    """(theta, phi): the radiance of a sky of unit irradiance (sun excluded) averaged over each
+    quad of the tally grid whose light travels down (theta < 90 deg from nadir), 0 elsewhere
+    (a polar cap's average in every phi column): air/rho's denominator for the mirror quads,
+    exact up to the midpoint rule on QUAD_SAMPLES^2 directions evenly spread in solid angle.
+    None for a sky map (sky_radiance)."""
+    n_theta, n_phi = len(theta_edges) - 1, len(phi_edges) - 1
+    out = np.zeros((n_theta, n_phi))
+    steps = (np.arange(QUAD_SAMPLES) + 0.5) / QUAD_SAMPLES
+    quads, dirs = [], []
+    for i in range(n_theta):
+        if theta_edges[i + 1] > 90.0:
+            continue
+        mu_top, mu_bottom = np.cos(np.radians(theta_edges[i:i + 2]))
+        mu = mu_bottom + steps * (mu_top - mu_bottom)
+        sin_t = np.sqrt(1.0 - mu * mu)
+        for j in range(1 if is_cap[i] else n_phi):
+            low, high = (-180.0, 180.0) if is_cap[i] else phi_edges[j:j + 2]
+            phi = np.radians(low + steps * (high - low))
+            quads.append((i, j))
+            dirs.append(np.stack([(sin_t[:, None] * np.cos(phi)[None, :]).ravel(),
+                                  (sin_t[:, None] * np.sin(phi)[None, :]).ravel(),
+                                  np.repeat(mu, QUAD_SAMPLES)], axis=1))
+    if not quads:
+        return out
+    radiance = sky_radiance(ill, np.concatenate(dirs))
+    if radiance is None:
+        return None
+    for (i, j), values in zip(quads, radiance.reshape(len(quads), -1)):
+        if is_cap[i]:
+            out[i, :] = values.mean()
+        else:
+            out[i, j] = values.mean()
+    return out
+
+
 def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: int,
                     batches: int) -> np.ndarray | None:
     """(batches, directions, 3): per batch, in each exact air direction of
