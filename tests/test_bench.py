@@ -178,6 +178,8 @@ def test_speed_section_alone_writes_speed_report(tmp_path, monkeypatch, capsys):
     assert "## Speed ceiling" in report and "## Start-up" in report
     assert "| cold start (empty cache) | bare_walk.yaml | plain | 99.00 | 98.00 |" in report
     assert "FAIL" in report and "Error against run time" not in report
+    # a quick report says so, and how to make it again (it read as a measurement)
+    assert "**Mode: quick**" in report and "`oceanmc bench --speed --quick -o DIR`" in report
     assert not (tmp_path / "s" / "bench.md").exists()
 
 

@@ -102,6 +102,18 @@ def speed_lines(data: dict) -> list[str]:
     return lines
 
 
+QUICK_FLAG = {True: " --quick", False: ""}
+
+
+def mode_lines(data: dict) -> list[str]:
+    """What a report of `oceanmc bench --quick` says first: its numbers come from small photon
+    counts (a smoke test that the bench runs), not measurements."""
+    if not data.get("quick"):
+        return []
+    return ["", "**Mode: quick** (`--quick`: small photon counts and repeats, a smoke test that "
+                "the bench runs; its times, errors and pass/FAIL rows are not measurements)."]
+
+
 def write_speed_report(out_dir: Path, data: dict) -> None:
     """DIR/speed.md and DIR/speed.json (`oceanmc bench --speed`): the speed ceiling, the
     feature costs and the start-up rows alone (what a change to the kernel reports)."""
@@ -110,8 +122,8 @@ def write_speed_report(out_dir: Path, data: dict) -> None:
     lines = ["# oceanmc benchmark: speed and start-up", "",
              f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
              f"numba {data['numba']}; kernel commit {kernel_commit()}. Regenerate with "
-             "`oceanmc bench --speed -o DIR` (the full `oceanmc bench` has these sections in "
-             "bench.md).", ""]
+             f"`oceanmc bench --speed{QUICK_FLAG[data['quick']]} -o DIR` (the full `oceanmc "
+             "bench` has these sections in bench.md).", *mode_lines(data), ""]
     (out_dir / "speed.md").write_text("\n".join(lines + speed_lines(data)) + "\n")
 
 
@@ -122,7 +134,7 @@ def write_report(out_dir: Path, data: dict) -> None:
     lines = ["# oceanmc benchmark", "",
              f"Machine: {data['machine']}; {data['date']}; oceanmc {data['version']}, "
              f"numba {data['numba']}; kernel commit {kernel_commit()}. Regenerate with "
-             f"`oceanmc bench -o {out_dir}`.", ""]
+             f"`oceanmc bench{QUICK_FLAG[data['quick']]} -o {out_dir}`.", *mode_lines(data), ""]
     lines += speed_lines(data)
     lines += ["", "## Error against run time", "",
               "FOM = 1 / (relative standard error^2 x wall time), median over the photon "
@@ -276,7 +288,8 @@ def run_section(out_dir: Path, name: str, quick: bool, measure, lines) -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / f"{name}.json").write_text(json.dumps({**data, "kernel_commit": commit},
                                                       indent=1))
-    (out_dir / f"{name}.md").write_text("\n".join(lines(data, commit)))
+    text = lines(data, commit)
+    (out_dir / f"{name}.md").write_text("\n".join(text[:1] + mode_lines(data) + text[1:]))
     print(f"wrote {out_dir / (name + '.md')}")
     return 0
 

@@ -142,6 +142,21 @@ def illumination_lines(result: Result) -> list[str]:
     return textwrap.wrap(line, 100, initial_indent="  ", subsequent_indent="    ")
 
 
+def sun_position_lines(result: Result) -> list[str]:
+    """A one-wavelength file's sun, where the scene gave it by date, time and place
+    (sun_position): the zenith angle that came to (a spectral file's illumination line says
+    it), else nothing."""
+    import yaml
+    try:
+        light = yaml.safe_load(result.config_yaml)["illumination"]
+        zenith = float(light["sun_zenith_deg"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return []
+    if not light.get("sun_position"):
+        return []
+    return [f"  sun at {zenith:.2f} deg from the zenith (sun_position)"]
+
+
 # the columns of a spectral run's table: (heading, quantity, depth index or None); the exact
 # directions of local_directions_deg follow Rrs nadir
 SPECTRAL_COLUMNS = (("Ed(0+)", "air/Ed", None), ("Rrs nadir", "air/Rrs_nadir", None),
@@ -447,6 +462,7 @@ def format_summary(result: Result) -> str:
     lines += data_file_lines(result)
     if "wavelength" in result.coords:
         return "\n".join(lines + format_spectrum(result))
+    lines += sun_position_lines(result)
     lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}{'rel err':>10}")
     for label, units, value, err in summary_rows(result):
         rel = abs(err / value) if value != 0.0 else 0.0
