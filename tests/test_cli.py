@@ -412,3 +412,18 @@ def test_show_iops_prints_each_layer_s_iops_and_the_bottom(tmp_path, scene_file)
     assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0
     done = oceanmc("show", "r.h5", "--iops", cwd=tmp_path)
     assert done.returncode == 0 and "IOPs the run used (1 layer" in done.stdout, done.stderr
+
+
+def test_a_one_wavelength_summary_says_the_sun_that_sun_position_came_to(small_scene):
+    """A spectral summary's illumination line says the sun's zenith angle; a one-wavelength
+    one said nothing of it, though sun_position computed it."""
+    from oceanmc import simulate
+    from oceanmc.run.summary import format_summary
+    small_scene["illumination"] = {"sun_position": {"time": "2024-06-21T14:00:00Z",
+                                                    "latitude_deg": 31.7,
+                                                    "longitude_deg": -64.2}}
+    small_scene.update(photons=2000)
+    text = format_summary(simulate(small_scene))
+    assert "  sun at 31.68 deg from the zenith (sun_position)" in text.splitlines()
+    small_scene["illumination"] = {"sun_zenith_deg": 30.0}
+    assert "sun_position" not in format_summary(simulate(small_scene))
