@@ -240,8 +240,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             except CannotResume as exc:
                 raise UsageError(f"--resume: {exc}") from None
         elif args.resume:   # (a resubmitted job whose first try never wrote: not an error)
-            print(f"oceanmc: --resume: no file at {out} to continue; running {path} from the "
-                  "start", file=sys.stderr, flush=True)
+            print(one_line(f"oceanmc: --resume: no file at {out} to continue; running {path} "
+                           "from the start"), file=sys.stderr, flush=True)
         scenes.append((path, run, RunFile(out, previous, args.overwrite)))
 
     stop = StopRequest()
@@ -377,7 +377,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     except OutputExists as exc:
         raise UsageError(str(exc)) from None
     except SweepError as exc:
-        print(f"oceanmc: config error: {exc}", file=sys.stderr)
+        print(one_line(f"oceanmc: config error: {exc}"), file=sys.stderr)
         return 2
     except CompileInterrupted as exc:
         # the compilation goes on in its own thread inside LLVM; leave at once (as cmd_run)

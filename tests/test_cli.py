@@ -427,3 +427,11 @@ def test_a_one_wavelength_summary_says_the_sun_that_sun_position_came_to(small_s
     assert "  sun at 31.68 deg from the zenith (sun_position)" in text.splitlines()
     small_scene["illumination"] = {"sun_zenith_deg": 30.0}
     assert "sun_position" not in format_summary(simulate(small_scene))
+
+
+def test_an_error_line_escapes_a_line_break_in_a_name(tmp_path, scene_file):
+    """Every refusal is one line: a name given with a line break (-o) is shown escaped."""
+    done = oceanmc("run", scene_file, "-o", "a\nb.yaml", cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "-o a\\nb.yaml: -o takes" in done.stderr, \
+        done.stderr

@@ -642,3 +642,34 @@ def test_bad_exr_on_the_command_line(tmp_path):
     assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
     assert f"sky map {tmp_path / 'cut.exr'}: cannot read it as OpenEXR" in lines[0], lines[0]
     assert not (tmp_path / "x.h5").exists()
+
+
+@pytest.mark.parametrize("sky", ["uniform", "cardioidal", "harrison_coombes"])
+def test_the_sky_over_each_downward_quad_integrates_to_its_irradiance(sky):
+    """scene.surface.sky_quad_radiance, air/rho's denominator: a unit sky's radiance over each
+    quad its light travels down through sums, times cos and the solid angle, to 1 (to 1%: the
+    cosine at each band's middle); 0 in the upward quads; a uniform sky is 1/pi everywhere,
+    and the Harrison-Coombes sky is brightest in the quad around the sun (zenith 30 deg,
+    travel azimuth 0), far above the one opposite."""
+    from oceanmc.scene.grid import make_grid
+    from oceanmc.scene.surface import sky_quad_radiance
+    config = oceanmc.load_config({
+        "illumination": {"sun_zenith_deg": 30, "sky": sky, "diffuse_fraction": 0.3},
+        "water": {"layers": [{"thickness_m": 1, "a": 0.1, "b": 0.1}]},
+        "bottom": {"model": "black"}})
+    grid = make_grid(config.tallies)
+    radiance = sky_quad_radiance(config.illumination, grid.theta_edges, grid.phi_edges,
+                                 grid.is_cap)
+    down = grid.theta < 90.0
+    omega = grid.solid_angle.copy()
+    omega[grid.is_cap, 1:] = 0.0   # a cap's one quad, counted once
+    mu = np.cos(np.radians(grid.theta))[:, None]
+    assert (radiance * mu * omega)[down].sum() == pytest.approx(1.0, abs=0.01)
+    assert np.all(radiance[~down] == 0.0) and np.all(radiance[down] > 0.0)
+    if sky == "uniform":
+        assert np.allclose(radiance[down], 1.0 / math.pi)
+    if sky == "harrison_coombes":
+        band = int(np.searchsorted(grid.theta_edges, 30.0, side="right")) - 1
+        toward, away = radiance[band, np.argmin(np.abs(grid.phi))], \
+            radiance[band, np.argmin(np.abs(np.abs(grid.phi) - 180.0))]
+        assert toward > 5.0 * away

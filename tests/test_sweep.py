@@ -679,13 +679,11 @@ print(hashlib.sha256(packed.floats.tobytes() + packed.ints.tobytes()).hexdigest(
 def test_a_packed_scene_does_not_depend_on_blas_threads():
     """A sweep's Dask workers run BLAS on one thread, `oceanmc run` on every core; a scene must
     pack to the same numbers either way, or a point is not its single run bit for bit. An
-    inelastic scene (the transfers) under a rough sea and a Harrison-Coombes sky: BLAS products
-    on one and two OpenBLAS threads differed in the last bit of its transfers, until the
-    packing summed them with numpy's own loops."""
+    inelastic scene with CDOM fluorescence (the transfers; the layers' backscattering): BLAS
+    products on one and two OpenBLAS threads differed in the last bit of its transfers, until
+    the packing summed them with numpy's own loops."""
     config = yaml.safe_load((REPO / "configs" / "raman_fluorescence.yaml").read_text())
     config["water"]["inelastic"]["cdom_fluorescence"] = {}
-    config["surface"] = {"model": "cox_munk", "wind_speed_m_s": 5.0}
-    config["illumination"]["sky"] = "harrison_coombes"
     digests = set()
     for threads in ("1", "2", "4"):
         env = dict(ENV, OPENBLAS_NUM_THREADS=threads, OMP_NUM_THREADS=threads,
@@ -726,3 +724,24 @@ def test_points_that_trace_other_wavelengths_share_the_union_grid(tmp_path, thre
         single = oceanmc.simulate(scene, threads=1)
         traced = flags[k] > 0
         assert np.array_equal(rrs[k, traced], single["air/Rrs_nadir"]), k
+
+
+def test_one_wavelength_points_beside_spectral_ones_take_their_place(tmp_path, thread_client):
+    """An axis over wavelengths_nm mixing one wavelength and two: the one-wavelength point's
+    values sit at its wavelength on the grid, NaN at the other (they were copied to every
+    wavelength, or the assembly crashed); a sweep of one-wavelength points keeps no wavelength
+    dimension; a point without wavelengths_nm beside spectral ones is refused before any run."""
+    axis = {"wavelengths_nm": [[450.0], [450.0, 550.0]]}
+    ds = oceanmc.sweep(sweep_file(tmp_path, axis), tmp_path / "lut.nc", client=thread_client,
+                       threads=1)
+    rrs = ds["air_Rrs_nadir"].values
+    assert list(ds["wavelength"].values) == [450.0, 550.0]
+    assert np.isfinite(rrs[0, 0]) and np.isnan(rrs[0, 1]) and np.isfinite(rrs[1]).all()
+    assert ds["wavelength_traced"].values.tolist() == [[1, 0], [1, 1]]
+    one = oceanmc.sweep(sweep_file(tmp_path, {"seed": [1, 2]},
+                                   base=dict(TINY, wavelengths_nm=[550.0])),
+                        tmp_path / "one.nc", client=thread_client, threads=1)
+    assert one["air_Rrs_nadir"].dims == ("seed",) and "wavelength_traced" not in one
+    with pytest.raises(SweepError, match="has no wavelengths_nm, point .* has: every point"):
+        build_points(load_sweep(sweep_file(tmp_path, {"wavelengths_nm": [None, [450.0,
+                                                                             550.0]]})))

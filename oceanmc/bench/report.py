@@ -106,8 +106,9 @@ QUICK_FLAG = {True: " --quick", False: ""}
 
 
 def mode_lines(data: dict) -> list[str]:
-    """What a report of `oceanmc bench --quick` says first: its numbers come from small photon
-    counts (a smoke test that the bench runs), not measurements."""
+    """What bench.md and speed.md of `oceanmc bench --quick` say first: their numbers come from
+    small photon counts (a smoke test that the bench runs), not measurements (the sections'
+    own reports say --quick in their regenerate lines)."""
     if not data.get("quick"):
         return []
     return ["", "**Mode: quick** (`--quick`: small photon counts and repeats, a smoke test that "
@@ -288,8 +289,7 @@ def run_section(out_dir: Path, name: str, quick: bool, measure, lines) -> int:
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / f"{name}.json").write_text(json.dumps({**data, "kernel_commit": commit},
                                                       indent=1))
-    text = lines(data, commit)
-    (out_dir / f"{name}.md").write_text("\n".join(text[:1] + mode_lines(data) + text[1:]))
+    (out_dir / f"{name}.md").write_text("\n".join(lines(data, commit)))
     print(f"wrote {out_dir / (name + '.md')}")
     return 0
 

@@ -50,7 +50,7 @@ class RunFacts:
         inelastic = config.water.inelastic
         grid = sc.angles
         return cls(
-            grid=sc.angles, depths=np.array(config.tallies.depths_m),
+            grid=grid, depths=np.array(config.tallies.depths_m),
             photons_per_batch=math.ceil(config.photons / config.batches),
             n_layers=len(config.water.layers),
             config_layer=np.array([layer.config_layer for layer in sc.layers], dtype=np.int64),
@@ -281,8 +281,7 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
                 sky_down[:, mirror, j] -= beam
             how = ("L_sky the run's own estimate of the sky radiance (sun excluded) of the quad "
                    "a flat surface reflects into this one (a sky map: a ratio of two batch "
-                   "estimates, biased low where few photons reach that quad; rho_local is "
-                   "exact)")
+                   "estimates, biased low where few photons reach that quad)")
         # each batch's own ratio, so that batches stay independent and runs merge
         lit = upward & (sky_down > 1e-12 * ed0)
         rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)

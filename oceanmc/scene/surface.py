@@ -94,9 +94,7 @@ def sky_quad_radiance(ill: cfg.Illumination, theta_edges: np.ndarray, phi_edges:
             dirs.append(np.stack([(sin_t[:, None] * np.cos(phi)[None, :]).ravel(),
                                   (sin_t[:, None] * np.sin(phi)[None, :]).ravel(),
                                   np.repeat(mu, QUAD_SAMPLES)], axis=1))
-    if not quads:
-        return out
-    radiance = sky_radiance(ill, np.concatenate(dirs))
+    radiance = sky_radiance(ill, np.concatenate(dirs) if dirs else np.zeros((0, 3)))
     if radiance is None:
         return None
     for (i, j), values in zip(quads, radiance.reshape(len(quads), -1)):

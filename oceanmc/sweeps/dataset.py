@@ -170,7 +170,10 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
         photons[point.index] = summary.photons
         wall[point.index] = summary.wall_time_s
         for name, (qdims, mean, stderr, units, description) in summary.quantities.items():
-            spectral = grid is not None and qdims[:1] == ("wavelength",)
+            if grid is not None and qdims[:1] != ("wavelength",):
+                # a one-wavelength point among spectral ones: its one wavelength's place
+                qdims, mean, stderr = ("wavelength",) + qdims, mean[None], stderr[None]
+            spectral = grid is not None
             if name not in arrays:
                 size = (len(grid),) + mean.shape[1:] if spectral else mean.shape
                 arrays[name] = (qdims, np.full(shape + size, np.nan),
@@ -188,10 +191,11 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
         data["wavelength_traced"] = (dims + ("wavelength",), traced, {
             "flag_values": np.array([0, 1, 2], dtype=np.int8),
             "flag_meanings": "not_traced asked added_for_the_excitation",
-            "description": "how the point traced each wavelength: 0 not at all (its quantities "
+            "description": "how the point traces each wavelength: 0 not at all (its quantities "
                            "NaN there), 1 asked for (wavelengths_nm), 2 added for the "
                            "excitation of its inelastic light (without the inelastic light "
-                           "excited below the point's grid)"})
+                           "excited below the point's grid); a point not run (status) is NaN "
+                           "at every wavelength"})
     data["status"] = (dims, status.astype(str), {"description": "done, failed or pending "
                                                  "(not run yet: an interrupted sweep)"})
     data["error"] = (dims, error.astype(str), {"description": "why a failed point failed"})
@@ -218,13 +222,15 @@ NOT_TRACED, ASKED, ADDED = 0, 1, 2
 
 def wavelength_grid(points: list[Point], shape: tuple[int, ...]
                     ) -> tuple[np.ndarray | None, dict[str, np.ndarray], np.ndarray | None]:
-    """The sweep's wavelength grid, every wavelength some point traces (points whose inelastic
-    light needs other excitation wavelengths trace other grids: an axis that switches Raman
-    scattering on, or moves an excitation range), each point's places on it by key, and per
-    point and wavelength the flag wavelength_traced (NOT_TRACED, ASKED, ADDED); (None, {},
-    None) for monochromatic points."""
+    """The sweep's wavelength grid, every wavelength some point traces (points trace other
+    grids where an axis is wavelengths_nm, or switches Raman scattering on, or moves an
+    excitation range), each point's places on it by key, and per point and wavelength the
+    flag wavelength_traced (NOT_TRACED, ASKED, ADDED); (None, {}, None) where every point
+    traces one wavelength (a one-wavelength result's layout: no wavelength dimension). A
+    scene without wavelengths_nm among spectral ones is refused before any run
+    (points.build_points)."""
     traced = {p.key: np.asarray(p.config.wavelengths, dtype=np.float64) for p in points}
-    if not points or any(np.isnan(w).any() for w in traced.values()):
+    if all(len(w) == 1 for w in traced.values()):
         return None, {}, None
     # one value per wavelength however each grid was computed (400 and 400.00000000000006)
     merged = np.unique(np.concatenate(list(traced.values())))

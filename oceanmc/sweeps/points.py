@@ -75,6 +75,7 @@ def build_points(spec: SweepSpec) -> list[Point]:
     if bad:
         _raise_first(bad)
     _check_same_tallies(points)
+    _check_known_wavelengths(points)
     return points
 
 
@@ -189,6 +190,18 @@ def _raise_first(bad: list[str]) -> None:
     more = f" (and {len(bad) - 1} more point{'s' if len(bad) > 2 else ''})" if len(bad) > 1 \
         else ""
     raise SweepError(bad[0] + more)
+
+
+def _check_known_wavelengths(points: list[Point]) -> None:
+    """One wavelength grid for the dataset (dataset.wavelength_grid) needs every point's
+    wavelengths: a scene without wavelengths_nm (one unnamed wavelength) cannot sit beside
+    spectral ones."""
+    unnamed = [p for p in points if any(math.isnan(w) for w in p.config.wavelengths)]
+    named = [p for p in points if p not in unnamed]
+    if unnamed and named:
+        raise SweepError(f"point ({unnamed[0].label}) has no wavelengths_nm, point "
+                         f"({named[0].label}) has: every point of a sweep needs wavelengths_nm "
+                         "for one wavelength grid, or none does")
 
 
 def _check_same_tallies(points: list[Point]) -> None:
