@@ -151,6 +151,19 @@ def test_merge_of_independent_runs(tmp_path, small_scene):
     assert not (tmp_path / "d.h5").exists()
 
 
+def test_merge_leaves_out_rho_of_two_definitions(small_scene):
+    """air/rho of a file written before its denominator became the sky's own radiance
+    (its description says the old way) is not joined with a newer run's: the merge leaves it
+    out, and keeps everything else."""
+    a, b = _small(1, small_scene), _small(2, small_scene)
+    assert "air/rho" in merge_results([a, b]).quantities
+    old = a.quantities["air/rho"]
+    a.quantities["air/rho"] = type(old)(old.name, old.dims, old.batches, old.units,
+                                        "an earlier definition")
+    merged = merge_results([a, b])
+    assert "air/rho" not in merged.quantities and "air/L_reflected" in merged.quantities
+
+
 def test_merge_refuses_different_scenes(small_scene):
     a = _small(1, small_scene)
     small_scene["bottom"]["reflectance"] = 0.5
