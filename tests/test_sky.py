@@ -673,3 +673,44 @@ def test_the_sky_over_each_downward_quad_integrates_to_its_irradiance(sky):
         toward, away = radiance[band, np.argmin(np.abs(grid.phi))], \
             radiance[band, np.argmin(np.abs(np.abs(grid.phi) - 180.0))]
         assert toward > 5.0 * away
+
+
+def test_a_uniform_map_gives_the_uniform_sky_s_rho_denominators(tmp_path):
+    """The sky radiance rho and rho_local divide by (scene.surface.sky_radiance) is read from a
+    map's cells (they had no map before 2026-11-29: rho estimated it from the run, rho_local
+    was left out): a uniform map's equals `sky: uniform`'s, over every mirror quad and in an
+    exact direction, to rounding; so do the two runs' rho_local, whose sky part samples the
+    surface with the same streams."""
+    from oceanmc.scene.grid import make_grid
+    from oceanmc.scene.surface import sky_quad_radiance
+    np.save(tmp_path / "sky.npy", np.ones((9, 36)))
+    scenes = [{"photons": 4000, "seed": 3, "tallies": {"depths_m": [0],
+                                                       "local_directions_deg": [[140, 135]]},
+               "illumination": {"sun_zenith_deg": 30, "diffuse_fraction": 0.3, "sky": sky},
+               "surface": {"model": "cox_munk", "wind_speed_m_s": 5.0},
+               "water": {"layers": [{"thickness_m": 1, "a": 0.1, "b": 0.1}]},
+               "bottom": {"model": "black"}}
+              for sky in ("uniform", {"map": str(tmp_path / "sky.npy")})]
+    configs = [oceanmc.load_config(scene) for scene in scenes]
+    grid = make_grid(configs[0].tallies)
+    quads = [sky_quad_radiance(c.illumination, grid.theta_edges, grid.phi_edges, grid.is_cap)
+             for c in configs]
+    assert np.allclose(quads[0], quads[1], rtol=1e-12, atol=0.0)
+    rho = [oceanmc.simulate(c)["air/rho_local"] for c in configs]
+    assert np.all(rho[0] > 0.0) and np.allclose(rho[0], rho[1], rtol=1e-12, atol=0.0)
+
+
+def test_map_radiance_reads_the_cell_the_sampler_draws_from():
+    """sky_maps.map_radiance follows the sampler's convention (test_view_to_travel_convention):
+    one bright cell at theta_view 30-34 deg, phi_view 176-184 deg is the radiance of light
+    travelling at 32 deg from nadir along phi 0, not along phi 180; the map's irradiance is 1."""
+    from oceanmc.scene.sky_maps import map_radiance
+    L = np.zeros((45, 90))
+    L[15:17, 44:46] = 1.0
+    theta, phi = np.linspace(0.0, 90.0, 46), np.linspace(0.0, 360.0, 91)
+    t = math.radians(32.0)
+    dirs = np.array([[math.sin(t), 0.0, math.cos(t)], [-math.sin(t), 0.0, math.cos(t)]])
+    along, against = map_radiance(theta, phi, L, dirs)
+    s = np.sin(np.radians(theta)) ** 2
+    cos_mass = np.diff(s)[15:17].sum() * np.radians(8.0) / 2.0   # the bright cells' integral
+    assert along == pytest.approx(1.0 / cos_mass) and against == 0.0

@@ -704,11 +704,11 @@ def test_grazing_collimated_sun_scalar_irradiance_is_exact():
 
 
 def test_sea_surface_rho_with_the_sun_in_the_polar_cap_is_one_value_across_the_cap(tmp_path):
-    """air/rho under a sky map (whose sky radiance the run estimates from its own downward
-    light) with the sun at the zenith: its beam falls in the downward polar cap, the mirror of
-    the nadir-viewing cap, and is taken out of that cap's sky radiance once. A cap is one quad,
-    so rho is the same in each of its phi columns (the beam was subtracted twice from column 0
-    until 2026-11-29, which left rho 0 there)."""
+    """air/rho under a sky map with the sun at the zenith, its beam in the downward polar cap,
+    the mirror of the nadir-viewing cap: a cap is one quad, so rho is the same in each of its
+    phi columns (the sun's beam, then taken out of the run's own estimate of the cap's sky
+    radiance, was subtracted twice from column 0 until 2026-11-29, which left rho 0 there; the
+    denominator is now the map's own radiance over the cap)."""
     np.save(tmp_path / "sky.npy", np.ones((9, 36)))   # a uniform sky as a map
     r = simulate(absorber_config(illumination={"Ed0": 1.0, "sun_zenith_deg": 0.0,
                                                "diffuse_fraction": 0.5,

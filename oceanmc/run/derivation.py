@@ -32,13 +32,12 @@ class RunFacts:
     directions: list            # local_directions_deg: (theta, phi) of the exact directions
     local_rows: list            # each direction's (water row, air row) in the tally `local`
     nadir_local: bool           # the nadir cap's local estimate gives Lu, Lw_nadir, Rrs_nadir
-    sun_zenith_deg: float       # where the sun's beam falls, taken out of the sky in rho
     parts: tuple[str, ...]      # the parts of the tally row: elastic, then each inelastic process
     wavelengths: np.ndarray     # (n_wl,) nm
     ed0: np.ndarray             # (n_wl,) Ed(0+) at each wavelength (the illumination spectrum)
     diffuse: np.ndarray         # (n_wl,) the sky's share of it
     sky_quads: np.ndarray | None  # (theta, phi) a unit sky's radiance over each downward quad
-    #                               (scene.surface.sky_quad_radiance), None for a sky map
+    #                               (scene.surface.sky_quad_radiance); None without radiance
 
     @classmethod
     def of(cls, config: SceneConfig, sc: Scene, ed0: np.ndarray,
@@ -56,7 +55,6 @@ class RunFacts:
             config_layer=np.array([layer.config_layer for layer in sc.layers], dtype=np.int64),
             radiance=config.tallies.radiance, directions=config.tallies.local_directions_deg,
             local_rows=sc.local_rows, nadir_local=config.nadir_local,
-            sun_zenith_deg=light.sun_zenith_deg,
             parts=("elastic",) + (tuple(name for name, _ in inelastic.processes())
                                   if inelastic is not None else ()),
             wavelengths=config.wavelengths, ed0=ed0, diffuse=diffuse,
@@ -230,7 +228,7 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
                   ed0: float, direct: float) -> None:
     """The radiance on the (theta, phi) quads at the tally depths and at 0+ (all light, the
     water-leaving light, the surface-reflected light and its reflectance factor rho, whose sky
-    radiance leaves out the sun's direct Ed(0+) `direct` at this wavelength), and the nadir
+    has the irradiance Ed(0+) less the sun's direct `direct` at this wavelength), and the nadir
     quantities from their polar cap (crossing estimates)."""
     grid, n_depths = facts.grid, len(facts.depths)
     omega = grid.solid_angle
@@ -254,40 +252,20 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
           "surface-reflected sun and sky radiance at 0+ (all light minus water-leaving); "
           "upward quads only")
     # the mirror of upward quad (theta, phi) is the downward quad (180 - theta, phi)
-    edges = grid.theta_edges
-    if np.allclose(edges, 180.0 - edges[::-1]):
-        if facts.sky_quads is not None:
-            # the sky's own radiance over the mirror quad (an analytic sky; its irradiance
-            # Ed0 f): exact, so each batch's rho is its L_reflected over a constant, and the
-            # mean over batches is unbiased. (The run's own estimate of it, as for a sky map
-            # below, made each batch's rho a ratio of two estimates, 0 where a batch put no
-            # sky photon in the mirror quad: 0.0073 +- 0.0018 for a flat surface's Fresnel
-            # 0.0211 at nadir with 10^4 photons; a user's review, 2026-11-29)
-            sky_down = np.broadcast_to((ed0 - direct) * facts.sky_quads[::-1], air_rad.shape)
-            how = ("L_sky the sky's radiance (sun excluded) averaged over the quad a flat "
-                   "surface reflects into this one")
-        else:
-            # a sky map: the run's own downward radiance there, less the sun's collimated
-            # beam where it falls (Ed0 (1 - f) / (mu_s Omega))
-            sky_down = air_rad[:, ::-1].copy()
-            theta_s = facts.sun_zenith_deg
-            i = min(int(np.searchsorted(edges, theta_s, side="right")) - 1, len(edges) - 2)
-            j = 0 if grid.is_cap[i] else int(np.searchsorted(grid.phi_edges, 0.0, "right")) - 1
-            beam = direct / max(math.cos(math.radians(theta_s)), 1e-12) / omega[i, j]
-            mirror = len(edges) - 2 - i
-            if grid.is_cap[i]:   # a cap is one quad: its value in every phi column
-                sky_down[:, mirror, :] -= beam
-            else:
-                sky_down[:, mirror, j] -= beam
-            how = ("L_sky the run's own estimate of the sky radiance (sun excluded) of the quad "
-                   "a flat surface reflects into this one (a sky map: a ratio of two batch "
-                   "estimates, biased low where few photons reach that quad)")
-        # each batch's own ratio, so that batches stay independent and runs merge
+    if np.allclose(grid.theta_edges, 180.0 - grid.theta_edges[::-1]):
+        # the sky's own radiance over the mirror quad (its irradiance Ed0 f): exact, so each
+        # batch's rho is its L_reflected over a constant, and the mean over batches is
+        # unbiased. (The run's own estimate of it made each batch's rho a ratio of two
+        # estimates, 0 where a batch put no sky photon in the mirror quad: 0.0073 +- 0.0018
+        # for a flat surface's Fresnel 0.0211 at nadir with 10^4 photons; a user's review,
+        # 2026-11-29)
+        sky_down = np.broadcast_to((ed0 - direct) * facts.sky_quads[::-1], air_rad.shape)
         lit = upward & (sky_down > 1e-12 * ed0)
         rho = np.where(lit, reflected / np.where(lit, sky_down, 1.0), 0.0)
         q.add("air/rho", ("theta", "phi"), rho, "1",
-              f"sea-surface reflectance factor L_reflected / L_sky per batch, {how}; upward "
-              "quads, 0 where there is no sky light")
+              "sea-surface reflectance factor L_reflected / L_sky per batch, L_sky the sky's "
+              "radiance (sun excluded) averaged over the quad a flat surface reflects into this "
+              "one; upward quads, 0 where there is no sky light")
     q.add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
           "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
     q.add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,

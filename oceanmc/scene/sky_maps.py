@@ -281,6 +281,23 @@ def read_sky_map(path, dataset: str = "radiance", layout: str = "auto"
     return theta, phi, L
 
 
+def map_radiance(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray,
+                 dirs: np.ndarray) -> np.ndarray:
+    """The radiance of a sky map of unit irradiance (integral L cos dOmega = 1 over its cells)
+    arriving in directions of travel dirs (downward, z > 0): each direction's cell, seen at
+    theta_view = its angle from nadir and phi_view = its travel azimuth - 180 deg (the
+    sampler's convention, module docstring)."""
+    s_edges = np.sin(np.radians(theta_deg)) ** 2
+    s_edges[0], s_edges[-1] = 0.0, 1.0
+    unit = L / cell_cos_mass(s_edges, np.radians(phi_deg), L).sum()
+    theta = np.degrees(np.arccos(np.clip(dirs[:, 2], -1.0, 1.0)))
+    phi = np.degrees(np.arctan2(dirs[:, 1], dirs[:, 0])) - 180.0
+    phi = phi_deg[0] + np.mod(phi - phi_deg[0], 360.0)
+    row = np.clip(np.searchsorted(theta_deg, theta, side="right") - 1, 0, len(theta_deg) - 2)
+    col = np.clip(np.searchsorted(phi_deg, phi, side="right") - 1, 0, len(phi_deg) - 2)
+    return np.where(dirs[:, 2] > 0.0, unit[row, col], 0.0)
+
+
 def harrison_coombes(cos_zenith, cos_psi, cos_sun):
     """Harrison & Coombes (1988) clear-sky radiance (relative units) of a sky element at zenith
     angle acos(cos_zenith), at the angle acos(cos_psi) from the sun at zenith acos(cos_sun)."""

@@ -2,7 +2,9 @@
 rough surface's table, scene/surface_table.py)."""
 from __future__ import annotations
 
+import functools
 import math
+import os
 
 import numpy as np
 
@@ -39,31 +41,44 @@ def pool(surface: cfg.Surface, packed: np.ndarray) -> np.ndarray:
 REFLECTED_SAMPLES = 4000
 
 
-def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0
-                 ) -> np.ndarray | None:
+def _sky_map(sky: cfg.SkyMap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sky map's cells (the run's packing has read and checked the file), read once while
+    the file stays the same: sky_radiance reads them for every batch of the reflected-radiance
+    estimates."""
+    stat = os.stat(sky.map)
+    return _read_sky_map(sky.map, sky.dataset, sky.layout, stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=4)
+def _read_sky_map(path: str, dataset: str, layout: str, mtime_ns: int, size: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return sky_maps.read_sky_map(path, dataset, layout)
+
+
+def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0) -> np.ndarray:
     """The radiance (sun excluded) of a sky of irradiance e_sky arriving in directions of
-    travel dirs (downward), for the analytic skies: uniform E_sky / pi; cardioidal (overcast)
-    E_sky 3 (1 + 2 cos) / (7 pi) (normalised so that integral L cos = E_sky). None for
-    tabulated skies."""
+    travel dirs (downward): uniform E_sky / pi; cardioidal (overcast) E_sky 3 (1 + 2 cos) /
+    (7 pi); Harrison-Coombes and a map normalised so that integral L cos = E_sky (a map: each
+    direction's cell, sky_maps.map_radiance)."""
+    if isinstance(ill.sky, cfg.SkyMap):
+        return e_sky * sky_maps.map_radiance(*_sky_map(ill.sky), dirs)
     if ill.sky == "uniform":
         return np.full(len(dirs), e_sky / math.pi)
     if ill.sky in ("cardioidal", "overcast"):
         return e_sky * 3.0 * (1.0 + 2.0 * dirs[:, 2]) / (7.0 * math.pi)
-    if ill.sky == "harrison_coombes":
-        sun = sky_maps.sun_travel(ill.sun_zenith_deg)
-        cos_sun = max(sun[2], 1e-6)
-        # normalised so that integral L cos = E_sky (midpoint rule, 400 x 720 cells)
-        mu = (np.arange(400) + 0.5) / 400
-        phi = (np.arange(720) + 0.5) * (2.0 * math.pi / 720)
-        s = np.sqrt(1.0 - mu * mu)[:, None]
-        cos_psi = s * np.cos(phi)[None, :] * sun[0] + mu[:, None] * sun[2]
-        integral = (sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]
-                    ).sum() * (1.0 / 400) * (2.0 * math.pi / 720)
-        # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
-        return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2],
-                                                           np.einsum("dk,k->d", dirs, sun),
-                                                           cos_sun)
-    return None
+    # harrison_coombes, normalised so that integral L cos = E_sky (midpoint rule, 400 x 720
+    # cells)
+    sun = sky_maps.sun_travel(ill.sun_zenith_deg)
+    cos_sun = max(sun[2], 1e-6)
+    mu = (np.arange(400) + 0.5) / 400
+    phi = (np.arange(720) + 0.5) * (2.0 * math.pi / 720)
+    s = np.sqrt(1.0 - mu * mu)[:, None]
+    cos_psi = s * np.cos(phi)[None, :] * sun[0] + mu[:, None] * sun[2]
+    integral = (sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]
+                ).sum() * (1.0 / 400) * (2.0 * math.pi / 720)
+    # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
+    return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2],
+                                                       np.einsum("dk,k->d", dirs, sun), cos_sun)
 
 
 # directions per quad, along mu and along phi, over which sky_quad_radiance averages a sky
@@ -71,12 +86,12 @@ QUAD_SAMPLES = 24
 
 
 def sky_quad_radiance(ill: cfg.Illumination, theta_edges: np.ndarray, phi_edges: np.ndarray,
-                      is_cap: np.ndarray) -> np.ndarray | None:
+                      is_cap: np.ndarray) -> np.ndarray:
     """(theta, phi): the radiance of a sky of unit irradiance (sun excluded) averaged over each
     quad of the tally grid whose light travels down (theta < 90 deg from nadir), 0 elsewhere
     (a polar cap's average in every phi column): air/rho's denominator for the mirror quads,
-    exact up to the midpoint rule on QUAD_SAMPLES^2 directions evenly spread in solid angle.
-    None for a sky map (sky_radiance)."""
+    exact up to the midpoint rule on QUAD_SAMPLES^2 directions evenly spread in solid angle
+    (a map's cells are read at each of them: sky_radiance)."""
     n_theta, n_phi = len(theta_edges) - 1, len(phi_edges) - 1
     out = np.zeros((n_theta, n_phi))
     steps = (np.arange(QUAD_SAMPLES) + 0.5) / QUAD_SAMPLES
@@ -95,8 +110,6 @@ def sky_quad_radiance(ill: cfg.Illumination, theta_edges: np.ndarray, phi_edges:
                                   (sin_t[:, None] * np.sin(phi)[None, :]).ravel(),
                                   np.repeat(mu, QUAD_SAMPLES)], axis=1))
     radiance = sky_radiance(ill, np.concatenate(dirs) if dirs else np.zeros((0, 3)))
-    if radiance is None:
-        return None
     for (i, j), values in zip(quads, radiance.reshape(len(quads), -1)):
         if is_cap[i]:
             out[i, :] = values.mean()
@@ -106,13 +119,13 @@ def sky_quad_radiance(ill: cfg.Illumination, theta_edges: np.ndarray, phi_edges:
 
 
 def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: int,
-                    batches: int) -> np.ndarray | None:
+                    batches: int) -> np.ndarray:
     """(batches, directions, 3): per batch, in each exact air direction of
     local_directions_deg (upward ones), the surface-reflected radiance of a sky of unit
     irradiance, that of a sun of unit direct irradiance Ed0 (1 - f), and the unit sky's
     radiance L_sky in the direction a flat surface reflects into it (rho's denominator, DESIGN
-    7.3); reflected_at scales them to a wavelength's light. None when the sky is tabulated or
-    no direction is upward. The sky part is a Monte Carlo average over REFLECTED_SAMPLES
+    7.3); reflected_at scales them to a wavelength's light; NaN for a direction that is not
+    upward. The sky part is a Monte Carlo average over REFLECTED_SAMPLES
     surface samples per batch (own streams from (seed, batch, 1)); the sun's part is the
     single-reflection glint (cox_munk.glint_single, exact up to the light the sun sends by two
     facets or more), 0 for a delta surface."""
@@ -130,8 +143,6 @@ def reflected_local(config: cfg.SceneConfig, surface: np.ndarray, first_batch: i
             continue
         mirror = np.array([[o[0], o[1], -o[2]]])
         l_sky_mirror = sky_radiance(ill, mirror)
-        if l_sky_mirror is None:
-            return None
         glint = 0.0 if surface["delta"] else cox_munk.glint_single(surface, *sun, *o) / max(
             math.cos(theta_s), 1e-12)
         for b in range(batches):
