@@ -289,7 +289,10 @@ def map_radiance(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray,
     sampler's convention, module docstring)."""
     s_edges = np.sin(np.radians(theta_deg)) ** 2
     s_edges[0], s_edges[-1] = 0.0, 1.0
-    unit = L / cell_cos_mass(s_edges, np.radians(phi_deg), L).sum()
+    # relative to the brightest cell first, as sky.pack does: sums over a map near 1.7e308
+    # would overflow
+    shape = L / L.max()
+    unit = shape / cell_cos_mass(s_edges, np.radians(phi_deg), shape).sum()
     theta = np.degrees(np.arccos(np.clip(dirs[:, 2], -1.0, 1.0)))
     phi = np.degrees(np.arctan2(dirs[:, 1], dirs[:, 0])) - 180.0
     phi = phi_deg[0] + np.mod(phi - phi_deg[0], 360.0)
