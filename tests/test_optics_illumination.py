@@ -114,3 +114,20 @@ def test_column_iops_and_the_illumination_take_a_scene_as_simulate_does(tmp_path
         assert np.array_equal(other[0].a, layers[0][0].a)
     assert layers[0][0].top_m == 0.0 and layers[0][0].thickness_m == 5.0
     assert np.array_equal(illumination_spectrum(scene)[0], illumination_spectrum(path)[0])
+
+
+def test_irradiance_units_follow_the_spectrum_model():
+    """A SPECTRL2 scene's irradiances and radiances are W m-2 nm-1 (sr-1) times Ed0, and say so
+    in their units (they said 'W m-2 (per unit Ed0)', a flat spectrum's, in files, figures and
+    the summary: a user's review); a flat spectrum's are per unit Ed0; Rrs is sr-1 in both."""
+    from oceanmc.run.summary import format_summary
+    base = {"photons": 2000, "wavelengths_nm": [550.0], "water": WATER,
+            "bottom": {"model": "none"}, "illumination": {"sun_zenith_deg": 30.0}}
+    flat = oceanmc.simulate(base)
+    spectrl2 = oceanmc.simulate(dict(base, illumination={"sun_zenith_deg": 30.0,
+                                                         "spectrum": {"model": "spectrl2"}}))
+    assert flat.quantities["air/Ed"].units == "W m-2 (per unit Ed0)"
+    assert spectrl2.quantities["air/Ed"].units == "W m-2 nm-1 (SPECTRL2 times Ed0)"
+    assert spectrl2.quantities["Lu"].units == "W m-2 nm-1 sr-1 (SPECTRL2 times Ed0)"
+    assert spectrl2.quantities["air/Rrs_nadir"].units == "sr-1"
+    assert "W/m2/nm" in format_summary(spectrl2) and "W/m2/nm" not in format_summary(flat)

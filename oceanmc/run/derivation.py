@@ -38,6 +38,7 @@ class RunFacts:
     diffuse: np.ndarray         # (n_wl,) the sky's share of it
     sky_quads: np.ndarray | None  # (theta, phi) a unit sky's radiance over each downward quad
     #                               (scene.surface.sky_quad_radiance); None without radiance
+    units: tuple[str, str]      # (irradiance, radiance) units (UNITS_BY_SPECTRUM)
 
     @classmethod
     def of(cls, config: SceneConfig, sc: Scene, ed0: np.ndarray,
@@ -59,7 +60,8 @@ class RunFacts:
                                   if inelastic is not None else ()),
             wavelengths=config.wavelengths, ed0=ed0, diffuse=diffuse,
             sky_quads=sky_quad_radiance(light, grid.theta_edges, grid.phi_edges, grid.is_cap)
-            if config.tallies.radiance else None)
+            if config.tallies.radiance else None,
+            units=UNITS_BY_SPECTRUM[light.spectrum.model])
 
     @property
     def inelastic(self) -> bool:
@@ -109,6 +111,15 @@ def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int
 
 RAD_UNITS = "W m-2 sr-1 (per unit Ed0)"
 IRR_UNITS = "W m-2 (per unit Ed0)"
+# (irradiance, radiance) units by illumination.spectrum model: a flat spectrum's Ed0 is Ed(0+)
+# itself, SPECTRL2 gives W m-2 nm-1 times Ed0 (the units above were written for it too until
+# 2026-11-29: a user's review), a table its own Ed0 column's units
+UNITS_BY_SPECTRUM = {
+    "flat": (IRR_UNITS, RAD_UNITS),
+    "spectrl2": ("W m-2 nm-1 (SPECTRL2 times Ed0)", "W m-2 nm-1 sr-1 (SPECTRL2 times Ed0)"),
+    "table": ("the units of the spectrum table's Ed0",
+              "the units of the spectrum table's Ed0, per sr"),
+}
 
 
 def budget_terms(n_layers: int, inelastic: bool = False) -> list[tuple[int, str, str]]:
@@ -179,6 +190,9 @@ def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
     if "reflected_local" in raw:
         add_reflected_local(q, raw["reflected_local"])
     add_budget(q, raw["budget"] / facts.photons_per_batch, facts)
+    to_units = dict(zip((IRR_UNITS, RAD_UNITS), facts.units))
+    for quantity in q.values():   # (the adders write a flat spectrum's units)
+        quantity.units = to_units.get(quantity.units, quantity.units)
     grid = facts.grid
     coords = {
         "depth": np.asarray(facts.depths, dtype=np.float64),

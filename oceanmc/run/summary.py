@@ -44,6 +44,8 @@ def summary_rows(result: Result) -> list[tuple[str, str, float, float]]:
     def row(label, name, units, index=None):
         if name not in result:
             return
+        if "nm-1" in result.quantities[name].units:   # a spectrum model's (SPECTRL2)
+            units = units.replace("W/m2", "W/m2/nm")
         value, err = result[name], result.stderr(name)
         if index is not None:
             value, err = value[index], err[index]
