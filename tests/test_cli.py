@@ -435,3 +435,17 @@ def test_an_error_line_escapes_a_line_break_in_a_name(tmp_path, scene_file):
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "-o a\\nb.yaml: -o takes" in done.stderr, \
         done.stderr
+
+
+def test_the_summary_warns_of_a_spectral_nadir_cap_without_upward_bias(small_scene):
+    """A spectral run's nadir-cap local estimate without upward-biased scattering reads low with
+    error bars that hide it at modest photon counts (a user's review): its summary says so; the
+    default (upward_fraction auto) says nothing of it."""
+    from oceanmc import simulate
+    from oceanmc.run.summary import format_summary
+    small_scene.update(photons=2000, wavelengths_nm=[450.0, 550.0])
+    default = format_summary(simulate(small_scene))
+    small_scene["estimator"] = {"upward_fraction": None}
+    unbiased = format_summary(simulate(small_scene))
+    assert "heavy-tailed in a spectral run" in " ".join(unbiased.split())
+    assert "heavy-tailed in a spectral run" not in " ".join(default.split())

@@ -85,7 +85,9 @@ def estimator_lines(result: Result) -> list[str]:
         if nadir_estimate(result) == "local":
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate"
                         + (" (air/Rrs_nadir_crossing: the crossing estimate)"
-                           if "air/Rrs_nadir_crossing" in result else ""))
+                           if "air/Rrs_nadir_crossing" in result else "")
+                        + (UNBIASED_SPECTRAL_CAP if "wavelength" in result.coords
+                           and not result.attrs.get("upward_fraction", 0) else ""))
         else:
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
                         f"through the cap{local_nadir_hint(result)})")
@@ -95,9 +97,19 @@ def estimator_lines(result: Result) -> list[str]:
         said.append(f"{which}: air/Rrs_local in the exact direction{'s' if len(ks) > 1 else ''} "
                     "(theta, phi of travel, deg) of tallies.local_directions_deg, local "
                     "(next-event) estimate: heavy-tailed with forward-peaked phase functions "
-                    "(Petzold, Fournier-Forand), whose error bars may understate it")
+                    "(Petzold, Fournier-Forand), far more through a wind-roughened sea, whose "
+                    "error bars may understate it many times (compare seeds)")
     return [line for text in said
             for line in textwrap.wrap(text, 100, initial_indent="  ", subsequent_indent="    ")]
+
+
+# a spectral run's nadir cap without scattering biased toward straight up (the analog walk,
+# or upward_fraction: null) is heavy-tailed in the bands where the hero's MIS weights swing
+# most: 7-16% low at 600-700 nm with 2-4 x 10^4 photons, z down to -9 (a user's review,
+# configs/case1_spectral.yaml, 2026-11-29)
+UNBIASED_SPECTRAL_CAP = ("; without upward-biased scattering (estimator.upward_fraction) it is "
+                         "heavy-tailed in a spectral run and may read low with error bars that "
+                         "do not show it; use upward_fraction auto or 0.1, or many more photons")
 
 
 def local_nadir_hint(result: Result) -> str:
