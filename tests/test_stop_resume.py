@@ -313,3 +313,24 @@ def test_a_resume_state_that_is_not_a_partial_results_is_refused(small_scene, ju
     line saying what it lacks (was a KeyError 'batch'), before any photon is traced."""
     with pytest.raises(MergeError, match=said):
         oceanmc.simulate(small_scene, resume_state=junk)
+
+
+def test_resume_with_other_command_line_counts_says_which_options_to_give(tmp_path, small_scene,
+                                                                           monkeypatch):
+    """A partial file run with --photons N, resumed without it, is refused with the option to
+    give again (it said 'made from a different scene ... (photons differs)'); a different
+    scene is still refused as one."""
+    from oceanmc.run.resume import CannotResume, partial_run
+    small_scene.update(photons=300_000, batches=6)
+    part = stopped_run(small_scene, monkeypatch, 0.005, 1)
+    assert part.attrs["partial"]
+    out = tmp_path / "p.h5"
+    part.save(out)
+    config = tmp_path / "scene.yaml"
+    config.write_text(yaml.safe_dump(dict(small_scene, photons=1000, seed=9)))
+    with pytest.raises(CannotResume, match=r"was run with --photons 300000 --seed 5: give "
+                                           r"--photons 300000 --seed 5 again"):
+        partial_run(out, simulation.prepare(oceanmc.load_config(config)), config)
+    config.write_text(yaml.safe_dump(dict(small_scene, batches=7)))
+    with pytest.raises(CannotResume, match="made from a different scene"):
+        partial_run(out, simulation.prepare(oceanmc.load_config(config)), config)

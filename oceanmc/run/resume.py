@@ -37,6 +37,13 @@ def partial_run(out: Path, run: PreparedRun, config_path: Path) -> Result:
         raise CannotResume(f"{out} is marked partial but holds batches up to {done - 1} of "
                            f"{config_path}'s {run.config.batches}: nothing to continue")
     differs = scene_difference(previous.config_yaml, run.scene_yaml)
+    if differs and not scene_difference(previous.config_yaml, run.scene_yaml, "photons", "seed"):
+        # only what `oceanmc run` takes on its command line: say which options to give again
+        import yaml
+        stored = yaml.safe_load(previous.config_yaml)
+        options = " ".join(f"--{key} {stored[key]}" for key in ("photons", "seed")
+                           if stored.get(key) != getattr(run.config, key))
+        raise CannotResume(f"{out} was run with {options}: give {options} again to continue it")
     if differs:
         raise CannotResume(f"{out} was made from a different scene than {config_path} "
                            f"({differs}; compare with `oceanmc show --config`)")
