@@ -81,9 +81,9 @@ def _outputs(configs: list[Path], out: str | None) -> list[Path]:
         if kind == "":
             return [target / f"{c.stem}.h5" for c in configs]   # several: the folder name/
         raise UsageError(several)   # an existing file
-    target = _results_file(out, allowed="a results file name ending in .h5 or without a suffix "
-                           "(NAME.h5; one config) or a folder (an existing one, or a name "
-                           "ending in /)")
+    target = _results_file(out, allowed="a results file name ending in .h5 (or .hdf5, .nc) or "
+                           "without a suffix (NAME.h5; one config) or a folder (an existing one, "
+                           "or a name ending in /)")
     if len(configs) > 1:
         raise UsageError(several)
     return [target]
@@ -197,7 +197,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
     if len(set(outputs)) != len(outputs):
-        raise UsageError("two configs share a file name; give them different names or run them "
+        twice = next(o for o in outputs if outputs.count(o) > 1)
+        same = " and ".join(str(c) for c, o in zip(configs, outputs) if o == twice)
+        raise UsageError(f"{same} would both write {twice}; give them different names or run them "
                          "separately with -o")
     overrides = {"photons": args.photons, "seed": args.seed}
 

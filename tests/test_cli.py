@@ -180,9 +180,10 @@ def test_output_without_a_suffix_is_the_results_file_with_h5_added(tmp_path, sce
 
 @pytest.mark.parametrize("command, out, expected", [
     ("run", "/dev/null", "-o /dev/null: not a regular file (a device, a FIFO or a socket); -o "
-     "takes a results file name ending in .h5 or without a suffix"),
-    ("run", "res.yaml", "-o res.yaml: -o takes a results file name ending in .h5 or without a "
-     "suffix (NAME.h5; one config) or a folder (an existing one, or a name ending in /)"),
+     "takes a results file name ending in .h5 (or .hdf5, .nc) or without a suffix"),
+    ("run", "res.yaml", "-o res.yaml: -o takes a results file name ending in .h5 (or .hdf5, "
+     ".nc) or without a suffix (NAME.h5; one config) or a folder (an existing one, or a name "
+     "ending in /)"),
     ("merge", "/dev/null", "-o /dev/null: not a regular file"),
     ("merge", "m.yaml", "-o m.yaml: -o takes a results file name ending in .h5 (or .hdf5, .nc)"),
     ("merge", "m.h5/", "-o m.h5/: a folder; -o takes a results file name ending in .h5"),
@@ -449,3 +450,14 @@ def test_the_summary_warns_of_a_spectral_nadir_cap_without_upward_bias(small_sce
     unbiased = format_summary(simulate(small_scene))
     assert "heavy-tailed in a spectral run" in " ".join(unbiased.split())
     assert "heavy-tailed in a spectral run" not in " ".join(default.split())
+
+
+def test_two_configs_that_would_write_one_file_are_named(tmp_path, small_scene):
+    """Two configs of one name in different folders, run into one folder: the refusal names
+    both and the file (it said only 'two configs share a file name')."""
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "s.yaml").write_text(yaml.safe_dump(small_scene))
+    done = oceanmc("run", "a/s.yaml", "b/s.yaml", "-o", "out/", cwd=tmp_path)
+    assert done.returncode == 2
+    assert "a/s.yaml and b/s.yaml would both write out/s.h5" in done.stderr, done.stderr
