@@ -121,7 +121,14 @@ def test_resume_refuses_a_different_scene(tmp_path, long_scene):
     other_path = tmp_path / "other.yaml"
     other_path.write_text(yaml.safe_dump(other))
     done = run(["run", other_path, "-o", out, "--resume"], tmp_path)
-    assert done.returncode == 2 and "different scene" in done.stderr
+    # (a seed of its own is a scene key `oceanmc run --seed` can give again: the message says
+    # how; any other key makes a different scene)
+    assert done.returncode == 2 and "was run with seed = 2" in done.stderr \
+        and "give --seed 2 to continue it" in done.stderr, done.stderr
+    other = dict(LONG, batches=LONG["batches"] + 1)
+    other_path.write_text(yaml.safe_dump(other))
+    done = run(["run", other_path, "-o", out, "--resume"], tmp_path)
+    assert done.returncode == 2 and "different scene" in done.stderr, done.stderr
 
 
 def _small(seed, small_scene):

@@ -328,8 +328,10 @@ def test_resume_with_other_command_line_counts_says_which_options_to_give(tmp_pa
     part.save(out)
     config = tmp_path / "scene.yaml"
     config.write_text(yaml.safe_dump(dict(small_scene, photons=1000, seed=9)))
-    with pytest.raises(CannotResume, match=r"was run with --photons 300000 --seed 5: give "
-                                           r"--photons 300000 --seed 5 again"):
+    with pytest.raises(CannotResume, match=r"was run with photons = 300000, seed = 5 \(the "
+                                           r"scene's, or given by --photons / --seed\), .* "
+                                           r"gives 1000, 9: give --photons 300000 --seed 5 to "
+                                           r"continue it"):
         partial_run(out, simulation.prepare(oceanmc.load_config(config)), config)
     config.write_text(yaml.safe_dump(dict(small_scene, batches=7)))
     with pytest.raises(CannotResume, match="made from a different scene"):

@@ -41,9 +41,12 @@ def partial_run(out: Path, run: PreparedRun, config_path: Path) -> Result:
         # only what `oceanmc run` takes on its command line: say which options to give again
         import yaml
         stored = yaml.safe_load(previous.config_yaml)
-        options = " ".join(f"--{key} {stored[key]}" for key in ("photons", "seed")
-                           if stored.get(key) != getattr(run.config, key))
-        raise CannotResume(f"{out} was run with {options}: give {options} again to continue it")
+        keys = [key for key in ("photons", "seed") if stored.get(key) != getattr(run.config, key)]
+        raise CannotResume(
+            f"{out} was run with {', '.join(f'{key} = {stored[key]}' for key in keys)} (the "
+            f"scene's, or given by --{' / --'.join(keys)}), {config_path} gives "
+            f"{', '.join(f'{getattr(run.config, key)}' for key in keys)}: give "
+            f"{' '.join(f'--{key} {stored[key]}' for key in keys)} to continue it")
     if differs:
         raise CannotResume(f"{out} was made from a different scene than {config_path} "
                            f"({differs}; compare with `oceanmc show --config`)")
