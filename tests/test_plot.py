@@ -339,4 +339,8 @@ def test_output_folder_with_or_without_a_trailing_separator(mono_file, tmp_path,
     assert main(["plot", str(mono_file), "-o", str(tmp_path / "run1")]) == 0
     assert sorted(p.name for p in tmp_path.glob("run1*")) == ["run1_profiles.png",
                                                              "run1_radiance.png", "run1_rrs.png"]
+    # a prefix written as a figure's name: its .png left out (it gave pic.png_rrs.png)
+    assert main(["plot", str(mono_file), "-o", str(tmp_path / "pic.png")]) == 0
+    assert sorted(p.name for p in tmp_path.glob("pic*")) == ["pic_profiles.png",
+                                                            "pic_radiance.png", "pic_rrs.png"]
     capsys.readouterr()

@@ -191,10 +191,11 @@ def stopped_saved_and_resumed(scene, monkeypatch, tmp_path):
     out = tmp_path / "p.h5"
     part.save(out)
     part = load_result(out)
-    rest = oceanmc.simulate(scene, threads=2, resume_state=part.resume_state)
+    rest = oceanmc.simulate(scene, threads=1, resume_state=part.resume_state)
     done = merge_results([part, rest], resume=True)
     for name, q in full.quantities.items():
         assert np.array_equal(done.quantities[name].batches, q.batches), name
+    assert done.attrs["threads"] == 1   # the continuing run's (it kept the first's, 2)
     return out, part
 
 

@@ -430,8 +430,8 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
     A figure whose every value is NaN is not drawn; a file of which nothing can be drawn (every
     value NaN: a run stopped before its first whole batch) is a PlotInputError. out: a folder
     (existing, or ending in '/'), the files then named after the results file, or a prefix to
-    which _rrs.png, _profiles.png, _radiance.png (and _kd_r.png) are appended; by default the
-    results file's path without .h5."""
+    which _rrs.png, _profiles.png, _radiance.png (and _kd_r.png) are appended (a .png it ends
+    with left out); by default the results file's path without .h5."""
     result = open_result(path)
     at_depth = depth_index(result, depth)
     indices = wavelength_indices(result, wavelength)
@@ -466,4 +466,5 @@ def _prefix(path: Path, out: str | Path | None) -> Path:
     text = str(out)
     if text.endswith(("/", "\\")) or Path(text).is_dir():
         return Path(text) / path.stem
-    return Path(text)
+    # a prefix given as a figure's name (-o pic.png): pic_rrs.png, not pic.png_rrs.png
+    return Path(text[:-len(".png")] if text.lower().endswith(".png") else text)

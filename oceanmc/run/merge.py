@@ -161,6 +161,8 @@ def merge_results(parts: list[Result], *, resume: bool = False) -> Result:
         if attrs["wall_time_s"] > 0 else float("inf")
     attrs["partial"] = bool(parts[-1].attrs.get("partial", False)) if resume else \
         any(bool(p.attrs.get("partial", False)) for p in parts)
+    if resume:   # the threads of the run that continued it, which its summary reports
+        attrs["threads"] = parts[-1].attrs["threads"]
     if not resume:
         attrs["seeds"] = ",".join(dict.fromkeys(str(r[0]) for r in ranges))
         attrs["batch_ranges"] = ",".join(f"{seed}:{lo}:{hi}" for seed, lo, hi, _ in ranges)
