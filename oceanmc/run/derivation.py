@@ -109,13 +109,11 @@ def per_config_layer(budget: np.ndarray, config_layer: np.ndarray, n_layers: int
     return out
 
 
-RAD_UNITS = "W m-2 sr-1 (per unit Ed0)"
-IRR_UNITS = "W m-2 (per unit Ed0)"
 # (irradiance, radiance) units by illumination.spectrum model: a flat spectrum's Ed0 is Ed(0+)
-# itself, SPECTRL2 gives W m-2 nm-1 times Ed0 (the units above were written for it too until
-# 2026-11-29: a user's review), a table its own Ed0 column's units
+# itself, SPECTRL2 gives W m-2 nm-1 times Ed0 (a flat spectrum's units were written for it too
+# until 2026-11-29: a user's review), a table its own Ed0 column's units
 UNITS_BY_SPECTRUM = {
-    "flat": (IRR_UNITS, RAD_UNITS),
+    "flat": ("W m-2 (per unit Ed0)", "W m-2 sr-1 (per unit Ed0)"),
     "spectrl2": ("W m-2 nm-1 (SPECTRL2 times Ed0)", "W m-2 nm-1 sr-1 (SPECTRL2 times Ed0)"),
     "table": ("the units of the spectrum table's Ed0",
               "the units of the spectrum table's Ed0, per sr"),
@@ -178,21 +176,19 @@ def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
     ed0 = float(facts.ed0[wavelength])
     scale = ed0 / facts.photons_per_batch
     q = Quantities()
-    add_irradiances(q, raw["flux"], facts.depths, scale)
+    irradiance_units, radiance_units = facts.units
+    add_irradiances(q, raw["flux"], facts.depths, scale, irradiance_units)
     if facts.radiance:
         # the sun's direct Ed(0+) at this wavelength (a spectrum's own diffuse share)
         direct = ed0 * (1.0 - float(facts.diffuse[wavelength]))
         add_radiances(q, raw["radiance"], facts, scale, ed0, direct)
     if facts.nadir_local:
-        add_nadir_local(q, raw["cap"] * scale, len(facts.depths), ed0)
+        add_nadir_local(q, raw["cap"] * scale, len(facts.depths), ed0, radiance_units)
     if len(facts.directions):
         add_exact_directions(q, raw["local"] * scale, facts, ed0)
     if "reflected_local" in raw:
-        add_reflected_local(q, raw["reflected_local"])
+        add_reflected_local(q, raw["reflected_local"], radiance_units)
     add_budget(q, raw["budget"] / facts.photons_per_batch, facts)
-    to_units = dict(zip((IRR_UNITS, RAD_UNITS), facts.units))
-    for quantity in q.values():   # (the adders write a flat spectrum's units)
-        quantity.units = to_units.get(quantity.units, quantity.units)
     grid = facts.grid
     coords = {
         "depth": np.asarray(facts.depths, dtype=np.float64),
@@ -208,27 +204,27 @@ def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
 
 
 def add_irradiances(q: Quantities, raw_flux: np.ndarray, depths: np.ndarray,
-                    scale: float) -> None:
+                    scale: float, units: str) -> None:
     """The plane and scalar irradiances at the tally depths and at 0+ (all light, and the
     water-leaving light alone), and the surface's upward transmittance t_up."""
     n_depths = len(depths)
     flux = raw_flux[:, :n_depths] * scale
-    q.add("Ed", ("depth",), flux[:, :, models.FLUX_ED], IRR_UNITS, "downward plane irradiance")
-    q.add("Eu", ("depth",), flux[:, :, models.FLUX_EU], IRR_UNITS, "upward plane irradiance")
-    q.add("Eod", ("depth",), flux[:, :, models.FLUX_EOD], IRR_UNITS,
+    q.add("Ed", ("depth",), flux[:, :, models.FLUX_ED], units, "downward plane irradiance")
+    q.add("Eu", ("depth",), flux[:, :, models.FLUX_EU], units, "upward plane irradiance")
+    q.add("Eod", ("depth",), flux[:, :, models.FLUX_EOD], units,
           "downward scalar irradiance")
-    q.add("Eou", ("depth",), flux[:, :, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance")
+    q.add("Eou", ("depth",), flux[:, :, models.FLUX_EOU], units, "upward scalar irradiance")
     q.add("Eo", ("depth",), flux[:, :, models.FLUX_EOD] + flux[:, :, models.FLUX_EOU],
-          IRR_UNITS, "scalar irradiance Eod + Eou")
+          units, "scalar irradiance Eod + Eou")
     air = raw_flux[:, n_depths] * scale
     leaving = raw_flux[:, n_depths + 1] * scale
-    q.add("air/Ed", (), air[:, models.FLUX_ED], IRR_UNITS,
+    q.add("air/Ed", (), air[:, models.FLUX_ED], units,
           "downward plane irradiance just above the surface (0+): sun and sky")
-    q.add("air/Eu", (), air[:, models.FLUX_EU], IRR_UNITS,
+    q.add("air/Eu", (), air[:, models.FLUX_EU], units,
           "upward plane irradiance at 0+: surface-reflected plus water-leaving")
-    q.add("air/Eod", (), air[:, models.FLUX_EOD], IRR_UNITS, "downward scalar irradiance at 0+")
-    q.add("air/Eou", (), air[:, models.FLUX_EOU], IRR_UNITS, "upward scalar irradiance at 0+")
-    q.add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], IRR_UNITS,
+    q.add("air/Eod", (), air[:, models.FLUX_EOD], units, "downward scalar irradiance at 0+")
+    q.add("air/Eou", (), air[:, models.FLUX_EOU], units, "upward scalar irradiance at 0+")
+    q.add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], units,
           "upward plane irradiance at 0+ from light transmitted out of the water only")
     at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
     if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
@@ -245,24 +241,25 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
     has the irradiance Ed(0+) less the sun's direct `direct` at this wavelength), and the nadir
     quantities from their polar cap (crossing estimates)."""
     grid, n_depths = facts.grid, len(facts.depths)
+    units = facts.units[1]
     omega = grid.solid_angle
     rad = raw_radiance * scale / omega
     rad[..., grid.is_cap, :] = rad[..., grid.is_cap, :1]  # a cap's one value in every phi column
     water_rad = rad[:, :n_depths]
     air_rad = rad[:, n_depths]
     lw = rad[:, n_depths + 1]
-    q.add("radiance", ("depth", "theta", "phi"), water_rad, RAD_UNITS,
+    q.add("radiance", ("depth", "theta", "phi"), water_rad, units,
           "radiance on the (theta, phi) quads, quad average; theta from nadir of the direction "
           "of travel, phi from the sun's travel azimuth")
-    q.add("Lu", ("depth",), water_rad[:, :, -1, 0], RAD_UNITS,
+    q.add("Lu", ("depth",), water_rad[:, :, -1, 0], units,
           "nadir-viewing radiance (upward travel), the polar-cap quad average")
-    q.add("air/radiance", ("theta", "phi"), air_rad, RAD_UNITS,
+    q.add("air/radiance", ("theta", "phi"), air_rad, units,
           "radiance at 0+, all light: sun, sky, surface reflection, water-leaving")
-    q.add("air/Lw", ("theta", "phi"), lw, RAD_UNITS,
+    q.add("air/Lw", ("theta", "phi"), lw, units,
           "water-leaving radiance at 0+ (surface-reflected light excluded); upward quads only")
     upward = (grid.theta > 90.0)[:, None]
     reflected = np.where(upward, air_rad - lw, 0.0)
-    q.add("air/L_reflected", ("theta", "phi"), reflected, RAD_UNITS,
+    q.add("air/L_reflected", ("theta", "phi"), reflected, units,
           "surface-reflected sun and sky radiance at 0+ (all light minus water-leaving); "
           "upward quads only")
     # the mirror of upward quad (theta, phi) is the downward quad (180 - theta, phi)
@@ -280,15 +277,16 @@ def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scal
               "sea-surface reflectance factor L_reflected / L_sky per batch, L_sky the sky's "
               "radiance (sun excluded) averaged over the quad a flat surface reflects into this "
               "one; upward quads, 0 where there is no sky light")
-    q.add("air/Lu", (), air_rad[:, -1, 0], RAD_UNITS,
+    q.add("air/Lu", (), air_rad[:, -1, 0], units,
           "nadir-viewing radiance at 0+ (water-leaving plus surface-reflected), polar cap")
-    q.add("air/Lw_nadir", (), lw[:, -1, 0], RAD_UNITS,
+    q.add("air/Lw_nadir", (), lw[:, -1, 0], units,
           "nadir water-leaving radiance at 0+, polar-cap quad average")
     q.add("air/Rrs_nadir", (), lw[:, -1, 0] / ed0, "sr-1",
           "remote-sensing reflectance Lw_nadir / Ed(0+)")
 
 
-def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: float) -> None:
+def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: float,
+                    units: str) -> None:
     """Lu, Lw_nadir and Rrs_nadir from the polar cap's local estimate (normalised `cap`); the
     crossing estimates of the quads, where tallied, stay beside them as *_crossing."""
     for name in ("Lu", "air/Lw_nadir", "air/Rrs_nadir"):
@@ -297,9 +295,9 @@ def add_nadir_local(q: Quantities, cap: np.ndarray, n_depths: int, ed0: float) -
             crossing.name = name + "_crossing"
             crossing.description += " (crossing estimator)"
             q[crossing.name] = crossing
-    q.add("Lu", ("depth",), cap[:, :n_depths], RAD_UNITS,
+    q.add("Lu", ("depth",), cap[:, :n_depths], units,
           "nadir-viewing radiance (upward travel), the polar-cap quad average, local estimate")
-    q.add("air/Lw_nadir", (), cap[:, n_depths], RAD_UNITS,
+    q.add("air/Lw_nadir", (), cap[:, n_depths], units,
           "nadir water-leaving radiance at 0+, polar-cap quad average, local estimate")
     q.add("air/Rrs_nadir", (), cap[:, n_depths] / ed0, "sr-1",
           "remote-sensing reflectance Lw_nadir / Ed(0+)")
@@ -309,23 +307,24 @@ def add_exact_directions(q: Quantities, local: np.ndarray, facts: RunFacts, ed0:
     """The radiances of the exact directions of local_directions_deg (normalised `local`) at
     the tally depths and leaving the water, and their Rrs."""
     n_depths = len(facts.depths)
+    units = facts.units[1]
     water_rows = [w for w, _ in facts.local_rows]
     air_rows = [a for _, a in facts.local_rows]
     q.add("local_radiance", ("depth", "direction"), local[:, :n_depths][:, :, water_rows],
-          RAD_UNITS, "radiance in the exact directions of local_directions_deg (theta, phi "
+          units, "radiance in the exact directions of local_directions_deg (theta, phi "
           "of travel), local (next-event) estimate")
-    q.add("air/Lw_local", ("direction",), local[:, n_depths][:, air_rows], RAD_UNITS,
+    q.add("air/Lw_local", ("direction",), local[:, n_depths][:, air_rows], units,
           "water-leaving radiance at 0+ in the exact directions of local_directions_deg, "
           "local (next-event) estimate")
     q.add("air/Rrs_local", ("direction",), local[:, n_depths][:, air_rows] / ed0, "sr-1",
           "Lw_local / Ed(0+)")
 
 
-def add_reflected_local(q: Quantities, reflected_local: np.ndarray) -> None:
+def add_reflected_local(q: Quantities, reflected_local: np.ndarray, units: str) -> None:
     """The surface-reflected radiance of the exact directions and its reflectance factor
     rho_local, from per batch (L_reflected, L_sky of the mirror direction)."""
     reflected, l_sky = reflected_local[..., 0], reflected_local[..., 1]
-    q.add("air/L_reflected_local", ("direction",), reflected, RAD_UNITS,
+    q.add("air/L_reflected_local", ("direction",), reflected, units,
           "surface-reflected sky and sun radiance at 0+ in the exact directions of "
           "local_directions_deg (sky: surface samples; sun: single-reflection glint)")
     if np.all(l_sky > 0.0):   # no sky, no rho

@@ -137,13 +137,10 @@ def local_nadir_hint(result: Result) -> str:
 def illumination_lines(result: Result) -> list[str]:
     """Where Ed(0+) came from, for a spectral file: the sun, the spectrum model or table and
     the sky's share of Ed(0+) over the band (none if the file does not say)."""
-    import yaml
-    try:
-        light = yaml.safe_load(result.config_yaml)["illumination"]
-        model = light["spectrum"]["model"]
-        zenith = float(light["sun_zenith_deg"])
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+    light = stored_illumination(result)
+    if light is None:
         return []
+    model, zenith = light["spectrum_model"], light["sun_zenith_deg"]
     diffuse = np.atleast_1d(result.attrs.get("illumination_diffuse_fraction", []))
     wl = result.coords["wavelength"]
     where = "sun_position" if light.get("sun_position") else "sun_zenith_deg"
@@ -160,15 +157,23 @@ def sun_position_lines(result: Result) -> list[str]:
     """A one-wavelength file's sun, where the scene gave it by date, time and place
     (sun_position): the zenith angle that came to (a spectral file's illumination line says
     it), else nothing."""
+    light = stored_illumination(result)
+    if light is None or not light.get("sun_position"):
+        return []
+    return [f"  sun at {light['sun_zenith_deg']:.2f} deg from the zenith (sun_position)"]
+
+
+def stored_illumination(result: Result) -> dict | None:
+    """The stored scene's illumination mapping, its sun_zenith_deg a float, and its spectrum's
+    model as spectrum_model; None where the file does not say (an unreadable or older
+    config)."""
     import yaml
     try:
         light = yaml.safe_load(result.config_yaml)["illumination"]
-        zenith = float(light["sun_zenith_deg"])
+        return dict(light, sun_zenith_deg=float(light["sun_zenith_deg"]),
+                    spectrum_model=str(light["spectrum"]["model"]))
     except (KeyError, TypeError, ValueError, yaml.YAMLError):
-        return []
-    if not light.get("sun_position"):
-        return []
-    return [f"  sun at {zenith:.2f} deg from the zenith (sun_position)"]
+        return None
 
 
 # the columns of a spectral run's table: (heading, quantity, depth index or None); the exact

@@ -287,8 +287,7 @@ def map_radiance(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray,
     arriving in directions of travel dirs (downward, z > 0): each direction's cell, seen at
     theta_view = its angle from nadir and phi_view = its travel azimuth - 180 deg (the
     sampler's convention, module docstring)."""
-    s_edges = np.sin(np.radians(theta_deg)) ** 2
-    s_edges[0], s_edges[-1] = 0.0, 1.0
+    s_edges = sin2_edges(theta_deg)
     # relative to the brightest cell first, as sky.pack does: sums over a map near 1.7e308
     # would overflow
     shape = L / L.max()
@@ -361,12 +360,18 @@ def sky_parameters(sun_zenith_deg: float) -> np.ndarray:
     return np.array([sun[0], sun[1], sun[2], sun[2], 0.0, 0.0, 0.0, 0.0])
 
 
+def sin2_edges(theta_deg: np.ndarray) -> np.ndarray:
+    """A map's row edges as sin^2 theta (cos dOmega = d(sin^2) dphi / 2), its first and last
+    exactly 0 and 1."""
+    s_edges = np.sin(np.radians(theta_deg)) ** 2
+    s_edges[0], s_edges[-1] = 0.0, 1.0
+    return s_edges
+
+
 def sampling_tables(theta_deg: np.ndarray, phi_deg: np.ndarray, L: np.ndarray) -> dict:
     """Marginal CDF over rows and conditional CDFs within rows of the cell probabilities
     L x integral of cos dOmega (= L (sin^2 theta_hi - sin^2 theta_lo) dphi / 2)."""
-    s_edges = np.sin(np.radians(theta_deg)) ** 2
-    s_edges[0] = 0.0
-    s_edges[-1] = 1.0
+    s_edges = sin2_edges(theta_deg)
     phi = np.radians(phi_deg)
     mass = cell_cos_mass(s_edges, phi, L)
     rows = mass.sum(axis=1)

@@ -66,19 +66,27 @@ def sky_radiance(ill: cfg.Illumination, dirs: np.ndarray, e_sky: float = 1.0) ->
         return np.full(len(dirs), e_sky / math.pi)
     if ill.sky in ("cardioidal", "overcast"):
         return e_sky * 3.0 * (1.0 + 2.0 * dirs[:, 2]) / (7.0 * math.pi)
-    # harrison_coombes, normalised so that integral L cos = E_sky (midpoint rule, 400 x 720
-    # cells)
+    # harrison_coombes
     sun = sky_maps.sun_travel(ill.sun_zenith_deg)
+    cos_sun = max(sun[2], 1e-6)
+    # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
+    return e_sky / _harrison_coombes_irradiance(ill.sun_zenith_deg) * sky_maps.harrison_coombes(
+        dirs[:, 2], np.einsum("dk,k->d", dirs, sun), cos_sun)
+
+
+@functools.lru_cache(maxsize=8)
+def _harrison_coombes_irradiance(sun_zenith_deg: float) -> float:
+    """integral L cos dOmega of the Harrison-Coombes sky in its relative units (midpoint rule,
+    400 x 720 cells), once per sun: sky_radiance runs for every batch of the reflected-radiance
+    estimates."""
+    sun = sky_maps.sun_travel(sun_zenith_deg)
     cos_sun = max(sun[2], 1e-6)
     mu = (np.arange(400) + 0.5) / 400
     phi = (np.arange(720) + 0.5) * (2.0 * math.pi / 720)
     s = np.sqrt(1.0 - mu * mu)[:, None]
     cos_psi = s * np.cos(phi)[None, :] * sun[0] + mu[:, None] * sun[2]
-    integral = (sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]
-                ).sum() * (1.0 / 400) * (2.0 * math.pi / 720)
-    # (numpy's own sum, not BLAS's, whose result depends on its threads: inelastic transfer)
-    return e_sky / integral * sky_maps.harrison_coombes(dirs[:, 2],
-                                                       np.einsum("dk,k->d", dirs, sun), cos_sun)
+    return float((sky_maps.harrison_coombes(mu[:, None], cos_psi, cos_sun) * mu[:, None]).sum()
+                 * (1.0 / 400) * (2.0 * math.pi / 720))
 
 
 # directions per quad, along mu and along phi, over which sky_quad_radiance averages a sky

@@ -173,13 +173,12 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
             if grid is not None and qdims[:1] != ("wavelength",):
                 # a one-wavelength point among spectral ones: its one wavelength's place
                 qdims, mean, stderr = ("wavelength",) + qdims, mean[None], stderr[None]
-            spectral = grid is not None
             if name not in arrays:
-                size = (len(grid),) + mean.shape[1:] if spectral else mean.shape
+                size = (len(grid),) + mean.shape[1:] if grid is not None else mean.shape
                 arrays[name] = (qdims, np.full(shape + size, np.nan),
                                 np.full(shape + size, np.nan), units, description)
             # a point's wavelengths in their places on the sweep's grid (NaN at the others)
-            at = point.index + (places[point.key],) if spectral else point.index
+            at = point.index + (places[point.key],) if grid is not None else point.index
             arrays[name][1][at] = mean
             arrays[name][2][at] = stderr
     for name, (qdims, mean, stderr, units, description) in arrays.items():
@@ -236,15 +235,19 @@ def wavelength_grid(points: list[Point], shape: tuple[int, ...]
     merged = np.unique(np.concatenate(list(traced.values())))
     keep = np.concatenate([[True], np.diff(merged) > WAVELENGTH_MATCH_NM])
     grid = merged[keep]
-    places = {key: np.abs(grid[None, :] - w[:, None]).argmin(axis=1)
-              for key, w in traced.items()}
+    places = {key: _nearest_places(grid, w) for key, w in traced.items()}
     flags = np.full(shape + (len(grid),), NOT_TRACED, dtype=np.int8)
     for point in points:
         flags[point.index + (places[point.key],)] = ASKED
         added = np.asarray(point.config.added_wavelengths, dtype=np.float64)
         if len(added):
-            flags[point.index + (np.abs(grid[None, :] - added[:, None]).argmin(axis=1),)] = ADDED
+            flags[point.index + (_nearest_places(grid, added),)] = ADDED
     return grid, places, flags
+
+
+def _nearest_places(grid: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
+    """Each wavelength's index on the grid (the nearest: the grid holds them all)."""
+    return np.abs(grid[None, :] - wavelengths[:, None]).argmin(axis=1)
 
 
 # two traced wavelengths closer than this are one (grids are computed, not typed)
