@@ -295,6 +295,27 @@ def test_all_nan_is_refused_and_a_nan_figure_is_left_out(mono_file, tmp_path, ca
                                                              "no_rrs_radiance.png"]
 
 
+def test_a_partial_file_says_so_in_every_figure(mono_file, tmp_path):
+    """A stopped run's file (attribute partial) is drawn from its whole batches, and each figure
+    says so in its corner with the batches it has of those asked for, as `oceanmc show` does; a
+    whole file's figures carry no such line."""
+    from oceanmc.plot import close
+    from oceanmc.plot.results import marked_partial, open_result, rrs_figure
+    from oceanmc.run.hdf5 import load_result
+    stopped = load_result(mono_file)
+    for q in stopped.quantities.values():
+        q.batches = q.batches[:5]
+    stopped.attrs.update(batches=5, partial=True)
+    path = stopped.save(tmp_path / "stopped.h5")
+    asked = load_result(mono_file).attrs["batches"]
+    for file, expected in ((path, [f"PARTIAL: 5 of {asked} batches whole (a stopped run)"]),
+                           (mono_file, [])):
+        result = open_result(file)
+        fig = marked_partial(rrs_figure(result), result)
+        assert [t.get_text() for t in fig.texts] == expected
+        close(fig)
+
+
 LONG_NAME = ("clear oligotrophic water with Petzold particles and a Fournier-Forand tail over "
              "a Lambertian sand bottom of reflectance 0.3 at ten metres, sun at 30 deg, 20% sky, "
              "run for the issue")

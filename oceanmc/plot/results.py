@@ -24,6 +24,7 @@ import numpy as np
 from ..config.loading import file_problem
 from ..run.format import SWEEP_DATASET_MESSAGE, SWEEP_TITLE
 from ..run.results import PART_LABELS
+from ..run.summary import planned_batches
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
 
 # at most this many wavelengths share a profile panel (evenly spaced over the file's grid), so
@@ -457,7 +458,21 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
               "kd_r": lambda: kd_r_figure(result)}
     prefix.parent.mkdir(parents=True, exist_ok=True)
     return {name: skipped[name] if name in skipped else
-            save(makers[name](), f"{prefix}_{name}.png") for name in drawn}
+            save(marked_partial(makers[name](), result), f"{prefix}_{name}.png")
+            for name in drawn}
+
+
+def marked_partial(fig, result: ResultFile):
+    """The figure, with a line in its bottom left corner when the file is partial (a stopped
+    run: its estimates use its whole batches only), as `oceanmc show` says it, so that a figure
+    passed on without the file still says so."""
+    attrs = result.water.attrs
+    if bool(attrs.get("partial", False)):
+        total = planned_batches(str(attrs.get("config_yaml", "")))
+        of = f" of {total}" if total is not None else ""
+        fig.text(0.005, 0.005, f"PARTIAL: {int(attrs['batches'])}{of} batches whole (a stopped "
+                 "run)", fontsize=7, color="C3", ha="left", va="bottom")
+    return fig
 
 
 def _prefix(path: Path, out: str | Path | None) -> Path:

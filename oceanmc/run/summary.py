@@ -354,6 +354,16 @@ def format_spectrum(result: Result) -> list[str]:
 RELIABLE_BATCHES = 8
 
 
+def planned_batches(config_yaml: str) -> int | None:
+    """The batches the stored scene asked for (a partial file holds fewer whole ones); None
+    where the stored text does not say."""
+    import yaml
+    try:
+        return int(yaml.safe_load(config_yaml)["batches"])
+    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return None
+
+
 def completeness_line(result: Result) -> str | None:
     """One line on a partial file (N of M batches whole) and on standard errors from fewer than
     RELIABLE_BATCHES batches; None for a complete file of enough batches."""
@@ -361,12 +371,7 @@ def completeness_line(result: Result) -> str | None:
     done = int(a["batches"])
     if not a.get("partial", False) and done >= RELIABLE_BATCHES:
         return None
-    import yaml
-    total = None
-    try:
-        total = int(yaml.safe_load(result.config_yaml)["batches"])
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
-        pass
+    total = planned_batches(result.config_yaml)
     of = f" of {total}" if total is not None else ""
     head = f"  PARTIAL: {done}{of} batches whole (a stopped run; the estimates use them only)" \
         if a.get("partial", False) else f"  note: {done} batches"
