@@ -241,6 +241,23 @@ def test_a_number_out_of_range_names_the_range_the_key_allows(tmp_path, small_sc
 
 
 @pytest.mark.parametrize("change, message", [
+    (lambda s: s.update(surface={"model": "coxmunk"}),
+     "surface.model = 'coxmunk': allowed: 'flat', 'none' or 'cox_munk' (did you mean "
+     "'cox_munk'?)"),
+    (lambda s: s.update(surface={"model": "wavy"}),
+     "surface.model = 'wavy': allowed: 'flat', 'none' or 'cox_munk'"),
+    (lambda s: s.update(estimator={"mode": "analogue"}),
+     "estimator.mode = 'analogue': allowed: 'implicit' or 'analog' (did you mean 'analog'?)"),
+])
+def test_a_word_not_allowed_is_answered_with_the_words_allowed(small_scene, change, message):
+    """One of a few words misspelt was refused in pydantic's words ("surface.model =
+    'coxmunk': Input should be 'flat', 'none' or 'cox_munk'", a user's review); now as every
+    other message, with the nearest word where it is a misspelling."""
+    change(small_scene)
+    assert _error(small_scene) == f"config: {message}"
+
+
+@pytest.mark.parametrize("change, message", [
     (lambda s: s.update(photons=True), "config: photons = True: expected a number"),
     (lambda s: s["water"]["layers"][0].update(a=True),
      "config: water.layers[0]: a = True: expected a number or a list"),

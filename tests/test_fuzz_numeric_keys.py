@@ -537,30 +537,35 @@ def test_spectral_layer_with_a_subnormal_b_at_every_wavelength_runs_finite():
 
 def test_spectral_scene_with_no_upwelling_light_at_one_wavelength_runs():
     """Clear water (b = 0) over a bottom, absorbing 1000 1/m at one of two wavelengths: a
-    KeyError traceback ('air/t_up'): from_tallies leaves the ratio Eu_water_leaving / Eu(0-)
-    out of a wavelength where a batch has no upwelling light (0/0), and stack_wavelengths
-    looked it up in every wavelength. It is now left out of the whole run, as out of a
-    monochromatic one; everything else is there."""
+    KeyError traceback ('air/t_up'): from_tallies left the ratio Eu_water_leaving / Eu(0-)
+    out of a wavelength where a batch had no upwelling light (0/0), and stack_wavelengths
+    looked it up in every wavelength. The ratio is now derived from the batch means
+    (run/derived.py t_up): defined where there is upwelling light, NaN where there is none;
+    everything else is there."""
+    from oceanmc.run.derived import derive
     scene = _mono(wavelengths_nm=[400, 500], tallies={"depths_m": [0]}, estimator={},
                   water={"layers": [{"thickness_m": 1.0, "a": [0.1, 1000.0], "b": 0.0}]})
     result = oceanmc.simulate(scene, threads=1)
     assert not finite(result)
-    assert "air/t_up" not in result and "air/Eu_water_leaving" in result
+    assert "air/Eu_water_leaving" in result
     assert result["Eu"][1, 0] == 0.0 and result["Eu"][0, 0] > 0.0
+    t_up = derive(result)["t_up"]
+    assert 0.0 < t_up.value[0] < 1.0 and np.isnan(t_up.value[1])
 
 
 def test_runs_differing_only_in_an_undefined_ratio_merge_without_it():
-    """The same class in merge_results: a run (or a resumed part) with a batch without
-    upwelling light lacks air/t_up; merging it with one that has it was refused ('different
-    quantities') or, on resume, a KeyError. The merge keeps the quantities both hold; any
-    other difference is still refused, naming the quantity."""
+    """The same class in merge_results: a file written before 2026-11-29 holds air/t_up per
+    batch, and one of its batches without upwelling light left it out; merging a run that has
+    it with one that lacks it was refused ('different quantities') or, on resume, a KeyError.
+    The merge keeps the quantities both hold; any other difference is still refused, naming
+    the quantity."""
     from oceanmc.run.results import MergeError, merge_results
     scene = _mono(tallies={"depths_m": [0]}, estimator={}, batches=2, photons=200,
                   water={"layers": [{"thickness_m": 1.0, "a": 0.5, "b": 0.0}]})
     first = oceanmc.simulate(scene, threads=1)
     second = oceanmc.simulate(dict(scene, seed=4), threads=1)
-    assert "air/t_up" in first and "air/t_up" in second
-    del second.quantities["air/t_up"]
+    old = first.quantities["air/Eu"]   # an older file's per-batch ratio, in the first run only
+    first.quantities["air/t_up"] = type(old)("air/t_up", (), old.batches / 2.0, "1", "t_up")
     merged = merge_results([first, second])
     assert "air/t_up" not in merged and merged.attrs["batches"] == 4
     assert merged["air/Eu"].shape == ()

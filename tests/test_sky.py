@@ -440,8 +440,8 @@ def test_sky_config(tmp_path):
         load_config(base("clear"))
     with pytest.raises(ConfigError, match="illumination.sky.map: required key is missing"):
         load_config(base({"file": "x.npy"}))
-    with pytest.raises(ConfigError, match="illumination.sky.sampling = 'uniform': Input should "
-                                          "be 'importance' or 'cosine'"):
+    with pytest.raises(ConfigError, match="illumination.sky.sampling = 'uniform': allowed: "
+                                          "'importance' or 'cosine'"):
         load_config(base({"map": "x.npy", "sampling": "uniform"}))
     np.save(tmp_path / "sky.npy", np.ones((9, 36)))
     (tmp_path / "scene.yaml").write_text(

@@ -283,7 +283,8 @@ def test_partial_summary_says_how_many_batches_and_that_few_give_unreliable_erro
     def shown(path):
         assert main(["show", str(path)]) == 0
         lines = capsys.readouterr().out.splitlines()
-        said = [line for line in lines if "PARTIAL" in line or "note:" in line]
+        said = [line for line in lines if "PARTIAL" in line or "note: " in line
+                and "batches" in line]
         assert len(said) == 1 and lines.index(said[0]) == 2, lines
         return said[0]
 

@@ -418,7 +418,11 @@ def _describe(error: dict) -> str:
         return msg
     loc = tuple(error.get("loc", ()))
     forms = _union_forms(loc)
-    if kind in _NOT_A_NUMBER and forms:
+    if kind == "literal_error" and "expected" in ctx and not forms:
+        # one of a few words (surface.model: coxmunk): pydantic's 'Input should be ...' in the
+        # words of every other message, with the nearest word when it is a misspelling
+        msg = f"allowed: {ctx['expected']}{_nearest_word(error.get('input'), ctx['expected'])}"
+    elif kind in _NOT_A_NUMBER and forms:
         # one member of a union that also takes a list, a file or a profile: its range alone
         # would read as all that is allowed (and a validator may bound it further, chl_mg_m3's
         # 100 mg/m3)
@@ -437,6 +441,18 @@ def _describe(error: dict) -> str:
             shown = shown[:77] + "..."
         return f"{path} = {shown}: {msg}"
     return f"{path}: {msg}"
+
+
+def _nearest_word(value: object, expected: str) -> str:
+    """' (did you mean 'cox_munk'?)' where `value` is a misspelling of one of the quoted words
+    of pydantic's `expected` ("'flat', 'none' or 'cox_munk'"); '' otherwise."""
+    import difflib
+    import re
+    if not isinstance(value, str):
+        return ""
+    words = re.findall(r"'([^']*)'", expected)
+    near = difflib.get_close_matches(value.lower(), words, n=1, cutoff=0.6)
+    return f" (did you mean {near[0]!r}?)" if near else ""
 
 
 # pydantic's types of the error for a number beyond one of its bounds

@@ -27,6 +27,8 @@ def spectrl2(spectrum: cfg.Illumination, zenith_deg: float, day_of_year: int | N
     import pvlib
     model = spectrum
     airmass = pvlib.atmosphere.get_relative_airmass(zenith_deg)
+    # ground_albedo 0: no multiple reflection between the surface and the sky (pvlib's default
+    # 0.2 is land's; the sea's ~0.06 would add 1.5% to Ed0 at 400 nm, 0.3% at 700)
     out = pvlib.spectrum.spectrl2(
         apparent_zenith=zenith_deg, aoi=zenith_deg, surface_tilt=0.0, ground_albedo=0.0,
         surface_pressure=model.surface_pressure_pa, relative_airmass=airmass,

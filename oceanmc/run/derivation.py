@@ -206,7 +206,8 @@ def from_tallies(raw: dict[str, np.ndarray], facts: RunFacts, wavelength: int,
 def add_irradiances(q: Quantities, raw_flux: np.ndarray, depths: np.ndarray,
                     scale: float, units: str) -> None:
     """The plane and scalar irradiances at the tally depths and at 0+ (all light, and the
-    water-leaving light alone), and the surface's upward transmittance t_up."""
+    water-leaving light alone; the surface's upward transmittance, their ratio, is derived from
+    the batch means: run/derived.py t_up)."""
     n_depths = len(depths)
     flux = raw_flux[:, :n_depths] * scale
     q.add("Ed", ("depth",), flux[:, :, models.FLUX_ED], units, "downward plane irradiance")
@@ -226,12 +227,6 @@ def add_irradiances(q: Quantities, raw_flux: np.ndarray, depths: np.ndarray,
     q.add("air/Eou", (), air[:, models.FLUX_EOU], units, "upward scalar irradiance at 0+")
     q.add("air/Eu_water_leaving", (), leaving[:, models.FLUX_EU], units,
           "upward plane irradiance at 0+ from light transmitted out of the water only")
-    at_surface = np.nonzero(np.asarray(depths) == 0.0)[0]
-    if len(at_surface) and np.all(flux[:, at_surface[0], models.FLUX_EU] > 0.0):
-        q.add("air/t_up", (), leaving[:, models.FLUX_EU] / flux[:, at_surface[0], models.FLUX_EU],
-              "1", "upward transmittance of the surface for this run's upwelling light: "
-              "Eu_water_leaving(0+) / Eu(0-) (absent when a batch, at any wavelength, has no "
-              "upwelling light)")
 
 
 def add_radiances(q: Quantities, raw_radiance: np.ndarray, facts: RunFacts, scale: float,
@@ -349,7 +344,7 @@ def add_budget(q: Quantities, budget: np.ndarray, facts: RunFacts) -> None:
 
 
 # what is not split into the parts of the light (add_parts): ratios, not sums over photons
-NOT_SPLIT = frozenset({"air/t_up", "air/rho", "air/rho_local"})
+NOT_SPLIT = frozenset({"air/rho", "air/rho_local"})
 
 
 def add_parts(whole: Result, parts: dict[str, Result]) -> None:

@@ -10,6 +10,10 @@ irradiances and radiances, each with its standard error; the results file's grou
 - at every tally depth: the irradiance reflectance R = Eu / Ed, the Q factor Q = Eu / Lu (sr),
   and the mean cosines mu_d = Ed / Eod (downward), mu_u = Eu / Eou (upward) and
   mu = (Ed - Eu) / Eo (total).
+- with depth 0 tallied, the surface's upward transmittance for the run's upwelling light,
+  t_up = Eu_water_leaving(0+) / Eu(0-) (no depth dimension). (Stored per batch as air/t_up
+  until 2026-11-29: the mean of the batches' ratios read high where Eu(0-) is noisy, 34% at
+  700 nm with 200 photons per batch.)
 KLu and Q need Lu: a scene with tallies.radiance false and no local nadir estimate has neither.
 
 Estimate and standard error. Each quantity is a function f of batch means (of Ed, Eu, ...), and
@@ -76,6 +80,9 @@ K_FUNCTIONS = (("Kd", "Ed", "downward plane irradiance Ed"),
                ("Ku", "Eu", "upward plane irradiance Eu"),
                ("Ko", "Eo", "scalar irradiance Eo"),
                ("KLu", "Lu", "nadir-viewing radiance Lu"))
+# every name derive() may give (a Result does not hold them: result.py names them in a KeyError)
+DERIVED_NAMES = tuple(name for name, _, _ in K_FUNCTIONS) + ("R", "Q", "mu_d", "mu_u", "mu",
+                                                              "t_up")
 
 
 def derive(result) -> dict[str, Derived]:
@@ -115,6 +122,12 @@ def derive(result) -> dict[str, Derived]:
         "Eu", "Eou")
     add("mu", dims, "1", "mean cosine of the whole light field (Ed - Eu) / Eo",
         lambda ed, eu, eo: (ed - eu) / eo, "Ed", "Eu", "Eo")
+    at_surface = np.nonzero(depths == 0.0)[0]
+    if len(at_surface):
+        surface = int(at_surface[0])
+        add("t_up", dims[:-1], "1", "upward transmittance of the surface for this run's "
+            "upwelling light: air/Eu_water_leaving (0+) / Eu(0-)",
+            lambda leaving, eu: leaving / eu[..., surface], "air/Eu_water_leaving", "Eu")
     return out
 
 
@@ -201,13 +214,21 @@ def format_derived(result) -> str:
     def label(d: Derived, index: int) -> str:
         if "depth_interval" in d.dims:
             return f"{d.name}({_where(depths[index])}..{depths[index + 1]:g} m)"
+        if "depth" not in d.dims:   # t_up: from 0- to 0+
+            return d.name
         return f"{d.name}({_where(depths[index])})"
+
+    def first(values: np.ndarray) -> np.ndarray:
+        """Per wavelength, the value at the first depth or interval (of a quantity that has
+        one)."""
+        return values[:, 0] if values.ndim == 2 else values
 
     if "wavelength" not in result.coords:
         lines.append(f"  {'quantity':<28}{'units':<9}{'value':>13}{'std err':>12}"
                      f"{'rel err':>10}")
         for d in derived.values():
-            for i, (value, err) in enumerate(zip(d.value, d.stderr)):
+            for i, (value, err) in enumerate(zip(np.atleast_1d(d.value),
+                                                 np.atleast_1d(d.stderr))):
                 if math.isnan(value):
                     lines.append(f"  {label(d, i):<28}{d.units:<9}{'undefined':>13}   "
                                  f"(a zero {' or '.join(d.sources)})")
@@ -222,13 +243,13 @@ def format_derived(result) -> str:
     # the K functions (over the first interval) in blocks of their own, then the ratios (at
     # the first depth), as the run's own spectral table (text_table.spectral_blocks)
     ordered = sorted(derived.values(), key=lambda d: "depth_interval" not in d.dims)
-    cells = [[_spectral_cell(d.value[k, 0], d.stderr[k, 0])
-              for k in range(len(result.coords["wavelength"]))] for d in ordered]
+    cells = [[_spectral_cell(value, err) for value, err in zip(first(d.value), first(d.stderr))]
+             for d in ordered]
     k_functions = sum("depth_interval" in d.dims for d in ordered)
     lines += spectral_blocks(result.coords["wavelength"], [label(d, 0) for d in ordered], cells,
                              (range(0, k_functions), range(k_functions, len(ordered))))
     note = ("(value and relative standard error; K in 1/m over the first interval of tally "
-            "depths, the others at the first depth; Q in sr; every depth and interval in the "
-            "file's group derived)")
+            "depths, the others at the first depth (t_up from 0- to 0+); Q in sr; every depth "
+            "and interval in the file's group derived)")
     return "\n".join(lines + textwrap.wrap(note, 100, initial_indent="  ",
                                            subsequent_indent="  "))

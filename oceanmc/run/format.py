@@ -161,6 +161,8 @@ def _write_iops(group: h5py.Group, iops: dict[str, np.ndarray]) -> None:
     if "bottom_reflectance" in iops:
         ds = group.create_dataset("bottom_reflectance", data=iops["bottom_reflectance"])
         ds.attrs["units"] = "1"
-        ds.attrs["description"] = ("the bottom's reflectance at each wavelength as the run used "
-                                   "it (a mixture's fraction-weighted)")
+        ds.attrs["description"] = ("the bottom's reflectance rho at each wavelength as the run "
+                                   "used it (a mixture's fraction-weighted): a lambertian "
+                                   "bottom's Eu/Ed, a minnaert bottom's scale (it reflects "
+                                   "2 rho cos^k t_i / (k + 2))")
         ds.dims[0].attach_scale(group["wavelength"])

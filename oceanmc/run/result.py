@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .derived import DERIVED_NAMES
 from .format import save_result
 
 
@@ -75,6 +76,11 @@ class Result:
         near = [q for q in self.quantities if q.rpartition("/")[2] == leaf] or \
             difflib.get_close_matches(str(name), list(self.quantities), n=3, cutoff=0.6)
         hint = f"; did you mean {' or '.join(near)}?" if near else ""
+        if str(name).startswith("derived/") or leaf in DERIVED_NAMES:
+            # the results file's group derived is computed from the batches, not held here
+            hint = (f"; {leaf} is derived from the batch means: "
+                    f"oceanmc.run.derived.derive(result)[{leaf!r}] (.value, .stderr), or the "
+                    "results file's group derived")
         raise KeyError(f"no quantity {name!r} in this result{hint}")
 
     def __repr__(self) -> str:
@@ -103,9 +109,11 @@ class Result:
 
 
 # ratios derivation.from_tallies leaves out of a Result where their denominator is 0 in a batch
-# (there is no value to give: 0/0): air/t_up without upwelling light at 0-, air/rho_local
-# without sky light. The wavelengths of a spectral run, and runs of one scene, may differ in
-# these only (a batch of very absorbing water may have no upwelling photon where another has some)
+# (there is no value to give: 0/0): air/rho_local without sky light, and air/t_up without
+# upwelling light at 0- in files written before 2026-11-29 (it is now derived from the batch
+# means: run/derived.py), which merge with newer ones that way. The wavelengths of a spectral
+# run, and runs of one scene, may differ in these only (a batch of very absorbing water may
+# have no upwelling photon where another has some)
 UNDEFINED_RATIOS = frozenset({"air/t_up", "air/rho_local"})
 
 

@@ -86,8 +86,9 @@ def estimator_lines(result: Result) -> list[str]:
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate"
                         + (" (air/Rrs_nadir_crossing: the crossing estimate)"
                            if "air/Rrs_nadir_crossing" in result else "")
-                        + (UNBIASED_SPECTRAL_CAP if "wavelength" in result.coords
-                           and not result.attrs.get("upward_fraction", 0) else ""))
+                        + ("" if result.attrs.get("upward_fraction", 0) else
+                           UNBIASED_SPECTRAL_CAP if "wavelength" in result.coords else
+                           UNBIASED_CAP))
         else:
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
                         f"through the cap{local_nadir_hint(result)})")
@@ -110,6 +111,15 @@ def estimator_lines(result: Result) -> list[str]:
 UNBIASED_SPECTRAL_CAP = ("; without upward-biased scattering (estimator.upward_fraction) it is "
                          "heavy-tailed in a spectral run and may read low with error bars that "
                          "do not show it; use upward_fraction auto or 0.1, or many more photons")
+
+# a one-wavelength run's, where auto leaves the bias off unless the depth windows are on
+# (scene/weight_window.upward_fraction): its error and time are the few packets' that travel
+# near straight up (kernel/upward.py); a user's review (Case-1 Chl 1 at 490 nm, 10^5 photons,
+# 2026-11-29) measured Rrs nadir at 9.6% without the bias and 3.6% with 0.1, at 2.2 times the
+# photons per second: 17 times the figure of merit (benchmarks/bench.md, clear ocean: 25x)
+UNBIASED_CAP = ("; without upward-biased scattering its variance comes from the few packets "
+                "travelling near straight up: estimator.upward_fraction: 0.1 (implicit walk) "
+                "gives it several to tens of times the figure of merit")
 
 
 def local_nadir_hint(result: Result) -> str:
@@ -457,7 +467,8 @@ def format_iops(result: Result) -> str:
                            [a, b, bb, c, np.where(b > 0.0, bb / b, np.nan),
                             np.where(c > 0.0, b / c, np.nan)])
     if "bottom_reflectance" in iops:
-        lines.append("  bottom")
+        lines.append("  bottom: its model's reflectance rho (a lambertian bottom's Eu/Ed; a "
+                     "minnaert bottom reflects 2 rho cos^k t_i / (k + 2))")
         lines += table(["reflectance"], [np.atleast_1d(iops["bottom_reflectance"])])
     return "\n".join(lines)
 
@@ -474,6 +485,9 @@ def format_summary(result: Result) -> str:
         f"{a['wall_time_s']:.2f} s, {a['photons_per_s']:,.0f} photons/s "
         f"(start-up {a['startup_time_s']:.2f} s)",
     ]
+    if "merged_from" in a:   # (oceanmc merge: the times above are the runs' sums)
+        lines.append(f"  merged from {a['merged_from']} runs (seeds {a.get('seeds')}); the "
+                     "times are their sums")
     at = single_wavelength(result)
     if at is not None and "wavelength" in result.coords:   # (and those its excitation needs)
         lines.append(f"  asked for {at:g} nm alone; the table holds the wavelengths traced for "
@@ -491,4 +505,9 @@ def format_summary(result: Result) -> str:
     for label, units, value, err in summary_rows(result):
         rel = abs(err / value) if value != 0.0 else 0.0
         lines.append(f"  {label:<28}{units:<9}{value:>13.6g}{err:>12.3g}{rel:>10.2%}")
+    scatters = "b" not in result.iops or np.any(np.asarray(result.iops["b"]) > 0.0)
+    if "air/Rrs_nadir" in result and nadir_estimate(result) == "local" and scatters \
+            and not result.attrs.get("upward_fraction", 0):
+        lines += textwrap.wrap("note: Rrs nadir (local)" + UNBIASED_CAP, 100,
+                               initial_indent="  ", subsequent_indent="    ")
     return "\n".join(lines)
