@@ -14,6 +14,7 @@ import signal
 import stat
 import sys
 import tempfile
+import warnings
 from pathlib import Path
 
 from . import __version__
@@ -355,7 +356,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     from .config.loading import file_problem
     from .run.compiling import CompileInterrupted
-    from .sweeps import OutputExists, SweepError, sweep
+    from .sweeps import FailedPoints, OutputExists, SweepError, sweep
 
     source = Path(args.sweep)
     out = _results_file(args.output, suffixes=(".nc",), what="a NetCDF file") \
@@ -370,12 +371,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                        "with those done and closing the workers")
     stop.install()
     try:
-        lut = sweep(source, out, workers=args.workers, scheduler=args.scheduler,
-                    threads=args.threads, batch_groups=args.batch_groups,
-                    workers_write=True if args.workers_write else None, progress=not args.quiet,
-                    log=lambda text: print(f"oceanmc: sweep: {text}", file=sys.stderr,
-                                           flush=True),
-                    overwrite=args.overwrite, should_stop=lambda: stop.requested)
+        with warnings.catch_warnings():   # the failed points are listed below, exit 1
+            warnings.simplefilter("ignore", FailedPoints)
+            lut = sweep(source, out, workers=args.workers, scheduler=args.scheduler,
+                        threads=args.threads, batch_groups=args.batch_groups,
+                        workers_write=True if args.workers_write else None,
+                        progress=not args.quiet,
+                        log=lambda text: print(f"oceanmc: sweep: {text}", file=sys.stderr,
+                                               flush=True),
+                        overwrite=args.overwrite, should_stop=lambda: stop.requested)
     except OutputExists as exc:
         raise UsageError(str(exc)) from None
     except SweepError as exc:

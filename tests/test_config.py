@@ -88,9 +88,9 @@ def _error(scene) -> str:
     (lambda s: s["water"]["layers"][0].update(b=-0.5), "water.layers[0].b = -0.5",
      "allowed: a number 0 .. 1e+06"),
     (lambda s: s["water"]["layers"][0]["phase"].update(g=1.0),
-     "water.layers[0].phase.g = 1.0", "allowed: a number > -1 and < 1"),
+     "water.layers[0].phase.g = 1.0", "allowed: a number -0.999999 .. 0.999999"),
     (lambda s: s["water"]["layers"][0]["phase"].update(g=-1.0),
-     "water.layers[0].phase.g = -1.0", "allowed: a number > -1 and < 1"),
+     "water.layers[0].phase.g = -1.0", "allowed: a number -0.999999 .. 0.999999"),
     (lambda s: s["surface"].update(n_water=0.9), "surface.n_water = 0.9",
      "allowed: a number 1 .. 3"),
     (lambda s: s["bottom"].update(reflectance=1.5), "bottom.reflectance = 1.5",
@@ -214,7 +214,7 @@ def test_a_value_no_member_of_a_union_takes_is_one_line_naming_what_each_allows(
     (lambda s: s["bottom"].update(reflectance=[0.2, -0.1]),
      "bottom.reflectance[1] = -0.1: allowed: a number 0 .. 1"),
     (lambda s: s["water"]["layers"][0]["phase"].update(g=1.0),
-     "water.layers[0].phase.g = 1.0: allowed: a number > -1 and < 1"),
+     "water.layers[0].phase.g = 1.0: allowed: a number -0.999999 .. 0.999999"),
     (lambda s: s["surface"].update(model="cox_munk", wind_speed_m_s=40),
      "surface.wind_speed_m_s = 40: allowed: a number 0 .. 30"),
     (lambda s: s.update(wavelengths_nm=[400, 50]),
@@ -248,6 +248,14 @@ def test_a_number_out_of_range_names_the_range_the_key_allows(tmp_path, small_sc
      "surface.model = 'wavy': allowed: 'flat', 'none' or 'cox_munk'"),
     (lambda s: s.update(estimator={"mode": "analogue"}),
      "estimator.mode = 'analogue': allowed: 'implicit' or 'analog' (did you mean 'analog'?)"),
+    # and lists of too few or too many, and a value that is no boolean (the same review)
+    (lambda s: s["water"].update(layers=[]), "water.layers = []: allowed: at least 1 item "
+     "(found 0)"),
+    (lambda s: s["tallies"].update(local_directions_deg=[[180, 0]] * 65),
+     "tallies.local_directions_deg = [[180, 0], [180, 0], [180, 0], [180, 0], [180, 0], "
+     "[180, 0], [180, 0], [180, ...: allowed: at most 64 items (found 65)"),
+    (lambda s: s["tallies"].update(radiance="maybe"),
+     "tallies.radiance = 'maybe': allowed: true or false"),
 ])
 def test_a_word_not_allowed_is_answered_with_the_words_allowed(small_scene, change, message):
     """One of a few words misspelt was refused in pydantic's words ("surface.model =

@@ -400,7 +400,7 @@ def test_ed0_below_1e_minus_100_is_refused_its_variances_would_underflow(tmp_pat
     below the smallest double): refused below 1e-100, as is a spectrum that brings it there."""
     for ed0 in (1e-101, 1e-300, 1e-308):
         refused(_mono(illumination={"Ed0": ed0}), f"illumination.Ed0 = {ed0:g}",
-                "allowed: 1e-100 .. 1e+100")
+                "allowed: a number 1e-100 .. 1e+100")
     result = oceanmc.simulate(_mono(illumination={"Ed0": 1e-100}, photons=400), threads=1)
     assert np.all(result.stderr("Ed") > 0.0) and np.all(result.stderr("Lu") > 0.0)
     (tmp_path / "s.csv").write_text("wavelength_nm,Ed0,diffuse_fraction\n400,1e-60,0.1\n"
@@ -421,7 +421,7 @@ def test_emission_weight_below_1e_minus_100_is_refused(scenes):
     scene = copy.deepcopy(scenes["inelastic"])
     for weight, shown in ((5e-324, "5e-324"), (1e-300, "1e-300"), (1e-101, "1e-101")):
         scene["estimator"]["emission_weight"] = weight
-        refused(scene, f"estimator.emission_weight = {shown}", "allowed: 1e-100 .. 1")
+        refused(scene, f"estimator.emission_weight = {shown}", "allowed: a number 1e-100 .. 1")
     scene["estimator"]["emission_weight"] = 1e-100
     assert not finite(oceanmc.simulate(scene, threads=1))
 
@@ -478,7 +478,7 @@ def test_an_asymmetry_within_1e_minus_6_of_one_is_refused(change, key):
     numpy's warning printed), SPECTRL2's aerosol factor of 1 - 1e-8 gave NaN irradiances (and
     pvlib's overflow warning). Allowed: -0.999999 .. 0.999999."""
     scene = _mono(**change)
-    refused(scene, f"{key} = ", "allowed: -0.999999 .. 0.999999")
+    refused(scene, f"{key} = ", "allowed: a number -0.999999 .. 0.999999")
     edge = copy.deepcopy(scene)
     node = edge
     parts = key.replace("[0]", ".0").split(".")

@@ -19,7 +19,7 @@ import yaml
 import oceanmc
 from conftest import REPO
 from oceanmc.run.derived import derive
-from oceanmc.sweeps import SweepError, load_sweep, set_key_path
+from oceanmc.sweeps import FailedPoints, SweepError, load_sweep, set_key_path
 from oceanmc.sweeps.dataset import variable_name
 from oceanmc.sweeps.points import build_points
 
@@ -139,6 +139,25 @@ def test_axes_product_zip_and_generators(tmp_path):
     with pytest.raises(SweepError, match="equal lengths"):
         load_sweep(sweep_file(tmp_path, {"zip": {"bottom.reflectance": [0.1, 0.2],
                                                  "water.layers[0].a": [0.1]}}))
+
+
+def test_a_notebook_s_numpy_axes_and_settings_are_the_lists_a_file_gives(tmp_path):
+    """A sweep given as a mapping with np.linspace axes and numpy numbers under `set` was
+    refused ('expected a non-empty list of values') or raised PyYAML's RepresenterError (a
+    user's review): the same points, labels and scenes as the plain lists."""
+    plain = {"base": TINY, "set": {"photons": 4000},
+             "axes": {"bottom.reflectance": [0.1, 0.2, 0.3],
+                      "zip": {"illumination.sun_zenith_deg": [0, 60],
+                              "illumination.diffuse_fraction": [0.1, 0.3]}}}
+    numpy = {"base": TINY, "set": {"photons": np.int64(4000)},
+             "axes": {"bottom.reflectance": np.linspace(0.1, 0.3, 3),
+                      "zip": {"illumination.sun_zenith_deg": np.array([0, 60]),
+                              "illumination.diffuse_fraction": [np.float64(0.1),
+                                                                np.float64(0.3)]}}}
+    expected, got = (build_points(load_sweep(spec)) for spec in (plain, numpy))
+    assert [p.key for p in got] == [p.key for p in expected]
+    assert [p.label for p in got] == [p.label for p in expected]
+    assert got[-1].config == expected[-1].config
 
 
 def test_an_axis_may_have_a_short_name(tmp_path):
@@ -418,7 +437,9 @@ def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch, t
 
     monkeypatch.setattr(simulation, "simulate", simulate)  # the workers are threads here
     path = sweep_file(tmp_path, {"water.layers[0].a": [0.1, 0.2, 0.3]})
-    ds = oceanmc.sweep(path, tmp_path / "lut.nc", client=thread_client, threads=1)
+    # (a notebook is told: it returned without a sign before, a user's review)
+    with pytest.warns(FailedPoints, match="1 of 3 points failed"):
+        ds = oceanmc.sweep(path, tmp_path / "lut.nc", client=thread_client, threads=1)
     assert list(ds["status"].values) == ["done", "failed", "done"]
     assert ds["error"].values[1] == "FloatingPointError: the kernel gave up on this point"
     assert np.isnan(ds["air_Rrs_nadir"].values[1])

@@ -302,19 +302,10 @@ Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
 # An asymmetry parameter (Henyey-Greenstein g, the Hapke grains', SPECTRL2's aerosols'): within
 # 1e-6 of +-1, as nothing natural comes near; closer, the computations lose all precision (a
 # Henyey-Greenstein g of 1 - 1e-10 gave NaN local estimates, SPECTRL2's aerosol factor of
-# 1 - 1e-8 NaN irradiances)
+# 1 - 1e-8 NaN irradiances). The bounds are the field's own, so that 1 and 0.9999995 are
+# refused with the same range (a validator after > -1 and < 1 named two: a user's review)
 MAX_ASYMMETRY = 1.0 - 1e-6
-
-
-def _not_at_one(g: float) -> float:
-    if abs(g) > MAX_ASYMMETRY:
-        raise ValueError(f"allowed: -{MAX_ASYMMETRY:.6f} .. {MAX_ASYMMETRY:.6f} (nearer to +-1 "
-                         "the computations lose all precision)")
-    return g
-
-
-Asymmetry = Annotated[float, Field(gt=-1.0, lt=1.0, allow_inf_nan=False),
-                      AfterValidator(_not_at_one)]
+Asymmetry = Annotated[float, Field(ge=-MAX_ASYMMETRY, le=MAX_ASYMMETRY, allow_inf_nan=False)]
 
 
 def _file_path(path: str) -> str:

@@ -65,16 +65,8 @@ class Estimator(_Strict):
     # emissions are made with probability weight / emission_weight and carry emission_weight
     # (kernel/channels/inelastic.py); measured best for packets in clear water
     # (benchmarks/inelastic.md)
-    emission_weight: Annotated[float, Field(gt=0.0, le=1.0, allow_inf_nan=False)] = \
-        DEFAULT_EMISSION_WEIGHT
-
-    @field_validator("emission_weight")
-    @classmethod
-    def _emission_weight_floor(cls, weight: float) -> float:
-        if weight < MIN_EMISSION_WEIGHT:   # pydantic would write 1e-100 out in 100 decimals
-            raise ValueError(f"allowed: {MIN_EMISSION_WEIGHT:g} .. 1 (an emitted packet's "
-                             "spectral weights divide by it)")
-        return weight
+    emission_weight: Annotated[float, Field(ge=MIN_EMISSION_WEIGHT, le=1.0,
+                                            allow_inf_nan=False)] = DEFAULT_EMISSION_WEIGHT
 
     @field_validator("depth_splitting", mode="before")
     @classmethod

@@ -41,12 +41,6 @@ class SkyMap(_Strict):
         return self
 
 
-def _ed0_floor(ed0: float) -> float:
-    if ed0 < MIN_ED0:   # pydantic would write 1e-100 out in 100 decimals
-        raise ValueError(f"allowed: {MIN_ED0:g} .. {MAX_ED0:g} (below {MIN_ED0:g} the "
-                         "variances of the tallies underflow to 0)")
-    return ed0
-
 
 SPA_LAST_YEAR = 6000
 
@@ -118,8 +112,8 @@ class Illumination(_Strict):
     """sky: uniform; cardioidal or overcast (the CIE standard overcast sky, L ~ 1 + 2 cos Z;
     Moon & Spencer 1942); harrison_coombes (clear sky, Harrison & Coombes 1988, with the sun at
     sun_zenith_deg); or {map: FILE} (sky_maps.py)."""
-    Ed0: Annotated[float, Field(gt=0.0, le=MAX_ED0, allow_inf_nan=False),
-                   AfterValidator(_ed0_floor)] = 1.0
+    # (below MIN_ED0 the variances of the tallies underflow to 0)
+    Ed0: Annotated[float, Field(ge=MIN_ED0, le=MAX_ED0, allow_inf_nan=False)] = 1.0
     sun_zenith_deg: Annotated[float, Field(ge=0.0, lt=90.0, allow_inf_nan=False)] = 30.0
     diffuse_fraction: Fraction = 0.0
     sky: Annotated[Union[Annotated[Literal["uniform", "cardioidal", "overcast",

@@ -418,7 +418,15 @@ def _describe(error: dict) -> str:
         return msg
     loc = tuple(error.get("loc", ()))
     forms = _union_forms(loc)
-    if kind == "literal_error" and "expected" in ctx and not forms:
+    if kind in _LENGTH_ERRORS and not forms:
+        # a list of too few or too many (water.layers: []): pydantic's 'List should have at
+        # least 1 item after validation, not 0' in the house words
+        count = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
+        msg = (f"allowed: {'at least' if kind == 'too_short' else 'at most'} {count} "
+               f"item{'s' if count != 1 else ''} (found {ctx.get('actual_length')})")
+    elif kind in _BOOLEAN_ERRORS and not forms:
+        msg = "allowed: true or false"
+    elif kind == "literal_error" and "expected" in ctx and not forms:
         # one of a few words (surface.model: coxmunk): pydantic's 'Input should be ...' in the
         # words of every other message, with the nearest word when it is a misspelling
         msg = f"allowed: {ctx['expected']}{_nearest_word(error.get('input'), ctx['expected'])}"
@@ -453,6 +461,11 @@ def _nearest_word(value: object, expected: str) -> str:
     words = re.findall(r"'([^']*)'", expected)
     near = difflib.get_close_matches(value.lower(), words, n=1, cutoff=0.6)
     return f" (did you mean {near[0]!r}?)" if near else ""
+
+
+# and for a list of too few or too many items, and a value that is no boolean
+_LENGTH_ERRORS = frozenset({"too_short", "too_long"})
+_BOOLEAN_ERRORS = frozenset({"bool_parsing", "bool_type"})
 
 
 # pydantic's types of the error for a number beyond one of its bounds

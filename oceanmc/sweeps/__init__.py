@@ -11,6 +11,7 @@ Dask cluster), dataset.py (per-point results files and the assembled dataset).
 from __future__ import annotations
 
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -28,6 +29,12 @@ __all__ = ["sweep", "prepare", "SweepError", "OutputExists", "SweepSpec", "load_
 def points_folder(output: Path) -> Path:
     """Where a dataset's finished points are kept: `LUT.nc` -> `LUT.points/`."""
     return output.with_suffix(".points")
+
+
+class FailedPoints(UserWarning):
+    """sweep() finished with points whose run raised (status `failed`, the error in the
+    dataset's `error`, NaN values): a notebook sees it without reading attribute
+    points_failed; the command, which lists them and exits 1, does not warn."""
 
 
 @dataclass
@@ -173,4 +180,9 @@ def sweep(source: str | Path | dict[str, Any], output: str | Path | None = None,
                     should_stop=should_stop)
             finally:   # also on Ctrl-C: the points done so far, before the cluster closes
                 dataset = finish()
+    failed = int(dataset.attrs.get("points_failed", 0))
+    if failed:
+        warnings.warn(f"{failed} of {dataset.attrs['points']} points failed (status 'failed', "
+                      "values NaN; each one's error in the variable 'error'): a rerun of the "
+                      "sweep runs them again", FailedPoints, stacklevel=2)
     return dataset

@@ -221,7 +221,7 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
         data = _read_yaml(path, str(path), "sweep")
         folder = path.parent
     else:
-        data, folder = source, Path.cwd()
+        data, folder = plain_values(source), Path.cwd()
     if not isinstance(data, dict):
         raise SweepError(f"sweep: the top level must be a mapping with keys {', '.join(SWEEP_KEYS)}"
                          f", got {type(data).__name__}")
@@ -246,6 +246,22 @@ def load_sweep(source: str | Path | dict) -> SweepSpec:
     check_count("batch_groups", groups, " (the number of tasks each point's batches are "
                 "spread over)")
     return SweepSpec(base, base_dir, dict(settings), axes, groups)
+
+
+def plain_values(value: Any) -> Any:
+    """A sweep given as a mapping with numpy's arrays and numbers in it (a notebook's axes:
+    np.linspace(0.1, 0.3, 5), np.float64) as the lists and numbers a YAML file gives, which the
+    points' labels and scenes are written from (an array was refused as no list, a list of
+    np.float64 raised PyYAML's RepresenterError: a user's review); anything else as it is."""
+    if isinstance(value, np.ndarray):
+        return plain_values(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, dict):
+        return {key: plain_values(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain_values(item) for item in value]
+    return value
 
 
 def check_count(name: str, value: Any, what: str = "") -> None:
