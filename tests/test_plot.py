@@ -297,10 +297,11 @@ def test_all_nan_is_refused_and_a_nan_figure_is_left_out(mono_file, tmp_path, ca
 
 def test_a_partial_file_says_so_in_every_figure(mono_file, tmp_path):
     """A stopped run's file (attribute partial) is drawn from its whole batches, and each figure
-    says so in its corner with the batches it has of those asked for, as `oceanmc show` does; a
-    whole file's figures carry no such line."""
+    says so in its corner with the batches it has of those asked for, as `oceanmc show` does,
+    whether `oceanmc plot` or a notebook draws it (a user's review: the notebook's did not); a
+    whole file's figures carry no such line, and a Result in hand is drawn as its file is."""
     from oceanmc.plot import close
-    from oceanmc.plot.results import marked_partial, open_result, rrs_figure
+    from oceanmc.plot.results import (profiles_figure, radiance_figure, rrs_figure)
     from oceanmc.run.hdf5 import load_result
     stopped = load_result(mono_file)
     for q in stopped.quantities.values():
@@ -308,12 +309,38 @@ def test_a_partial_file_says_so_in_every_figure(mono_file, tmp_path):
     stopped.attrs.update(batches=5, partial=True)
     path = stopped.save(tmp_path / "stopped.h5")
     asked = load_result(mono_file).attrs["batches"]
-    for file, expected in ((path, [f"PARTIAL: 5 of {asked} batches whole (a stopped run)"]),
-                           (mono_file, [])):
-        result = open_result(file)
-        fig = marked_partial(rrs_figure(result), result)
-        assert [t.get_text() for t in fig.texts] == expected
-        close(fig)
+    for source, expected in ((path, [f"PARTIAL: 5 of {asked} batches whole (a stopped run)"]),
+                             (stopped, [f"PARTIAL: 5 of {asked} batches whole (a stopped run)"]),
+                             (mono_file, [])):
+        for figure in (rrs_figure, profiles_figure, radiance_figure):
+            fig = figure(source)
+            said = [t.get_text() for t in fig.texts if t.get_text().startswith("PARTIAL")]
+            assert said == expected, figure
+            close(fig)
+
+
+def test_a_notebook_s_figures_refuse_what_they_cannot_draw_in_one_line(mono_file, tmp_path):
+    """From a notebook (a user's review): a file with no whole batch gave a blank figure and a
+    numpy warning, radiance_figure's depth in metres numpy's IndexError, and something other
+    than a file AttributeError; each is a PlotInputError saying what the figures take."""
+    from oceanmc.plot.results import PlotInputError, radiance_figure, rrs_figure
+    from oceanmc.run.hdf5 import load_result
+    empty = load_result(mono_file)
+    for q in empty.quantities.values():
+        q.batches = q.batches[:0]
+    empty.attrs.update(batches=0, partial=True, photons=0)
+    path = empty.save(tmp_path / "empty.h5")
+    with pytest.raises(PlotInputError, match="a partial file with no whole batch yet"):
+        rrs_figure(path)
+    depths = load_result(mono_file).coords["depth"]
+    for depth in (5.0, len(depths), -1):
+        with pytest.raises(PlotInputError, match=rf"depth = {depth!r}: the index of one of the "
+                                                 rf"file's depths, an integer 0 \.\. "
+                                                 rf"{len(depths) - 1} \(m: .*`oceanmc plot` "
+                                                 "takes --depth in metres"):
+            radiance_figure(mono_file, depth=depth)
+    with pytest.raises(PlotInputError, match="dict: the figures take a results file's path"):
+        rrs_figure({"air": None})
 
 
 LONG_NAME = ("clear oligotrophic water with Petzold particles and a Fournier-Forand tail over "

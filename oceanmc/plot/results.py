@@ -16,6 +16,7 @@ dimension of every spectral quantity; a monochromatic file has none, and both ar
 """
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -153,10 +154,25 @@ def _wavelength_label(result: ResultFile, index: int | None) -> str:
 
 # --- the figures -------------------------------------------------------------------------------
 
-def opened(result: ResultFile | str | Path) -> ResultFile:
-    """A results file's path opened (open_result), for the figure functions below, which a
-    notebook calls with a path."""
-    return open_result(result) if isinstance(result, (str, Path)) else result
+def opened(result) -> ResultFile:
+    """What the figure functions below take, opened: a results file's path (open_result), a
+    Result that simulate() returned in a notebook (written to a temporary file and read back:
+    the figures read the file's groups), or a ResultFile. A file without a whole batch (a run
+    stopped before its first) is a PlotInputError, as `oceanmc plot` refuses it."""
+    from ..run.result import Result
+    if isinstance(result, Result):
+        with tempfile.TemporaryDirectory(prefix="oceanmc-plot-") as folder:
+            return opened(result.save(Path(folder) / "result.h5"))
+    if isinstance(result, (str, Path)):
+        result = open_result(result)
+    if not isinstance(result, ResultFile):
+        raise PlotInputError(f"{type(result).__name__}: the figures take a results file's "
+                             "path, a Result (oceanmc.simulate's) or an opened file "
+                             "(open_result)")
+    if int(result.water.attrs.get("batches", 1)) == 0:
+        raise PlotInputError(f"{result.path}: a partial file with no whole batch yet, nothing "
+                             "to draw (`oceanmc run --resume` continues it)")
+    return result
 
 
 def rrs_figure(result: ResultFile | str | Path):
@@ -194,7 +210,7 @@ def rrs_figure(result: ResultFile | str | Path):
     ax.set_title(fit_title(f"remote-sensing reflectance: {name}", size[0] - 0.9, 9), fontsize=9)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7 if result.parts else 8)
-    return fig
+    return marked_partial(fig, result)
 
 
 # the log axis of Rrs by part reaches at most this far below its largest value: in clear water
@@ -288,7 +304,7 @@ def kd_r_figure(result: ResultFile | str | Path):
     kd = np.asarray(derived["Kd"])
     if np.isfinite(kd).any() and np.nanmin(kd) > 0.0:   # (all NaN: numpy would warn)
         axes[0].set_yscale("log")
-    return fig
+    return marked_partial(fig, result)
 
 
 def profiles_figure(result: ResultFile | str | Path, indices: list[int] | None = None):
@@ -318,7 +334,7 @@ def profiles_figure(result: ResultFile | str | Path, indices: list[int] | None =
     axes[0].set_ylabel("depth (m; 0 is 0-, just below the surface)")
     if indices:
         axes[0].legend(fontsize=7, title="wavelength", title_fontsize=7)
-    return fig
+    return marked_partial(fig, result)
 
 
 def _log_x(ax, values: np.ndarray) -> None:
@@ -355,6 +371,10 @@ def radiance_figure(result: ResultFile | str | Path, depth: int = 0,
         wavelength = len(result.wavelengths) // 2
     if "radiance" not in result.water:
         return None
+    _check_index("depth", depth, result.depths, "m", "--depth in metres")
+    if result.wavelengths is not None:
+        _check_index("wavelength", wavelength, result.wavelengths, "nm",
+                     "--wavelength in nm")
     theta_edges = np.asarray(result.water.coords["theta_edges"], dtype=np.float64)
     phi_edges = np.asarray(result.water.coords["phi_edges"], dtype=np.float64)
     rows = [(f"{result.depths[depth]:g} m" + (" (0-)" if result.depths[depth] == 0 else ""),
@@ -380,7 +400,18 @@ def radiance_figure(result: ResultFile | str | Path, depth: int = 0,
     label = _wavelength_label(result, wavelength)
     fig.suptitle("radiance on the quads (azimuth: phi of travel from the sun's travel azimuth)"
                  + (f", {label}" if label else ""), fontsize=9)
-    return fig
+    return marked_partial(fig, result)
+
+
+def _check_index(name: str, index, values: np.ndarray, units: str, command: str) -> None:
+    """radiance_figure's depth and wavelength are indices into the file's coordinates (the
+    command's options are the values): anything else is a PlotInputError naming them, not
+    numpy's IndexError."""
+    if isinstance(index, bool) or not isinstance(index, (int, np.integer)) \
+            or not 0 <= index < len(values):
+        raise PlotInputError(f"{name} = {index!r}: the index of one of the file's {name}s, an "
+                             f"integer 0 .. {len(values) - 1} ({units}: {_listed(values)}); "
+                             f"`oceanmc plot` takes {command}")
 
 
 # the quantity each figure needs, for the note when a file lacks it
@@ -457,8 +488,7 @@ def plot_result(path: str | Path, out: str | Path | None = None, depth: float | 
               "radiance": lambda: radiance_figure(result, at_depth, radiance_wavelength),
               "kd_r": lambda: kd_r_figure(result)}
     prefix.parent.mkdir(parents=True, exist_ok=True)
-    return {name: skipped[name] if name in skipped else
-            save(marked_partial(makers[name](), result), f"{prefix}_{name}.png")
+    return {name: skipped[name] if name in skipped else save(makers[name](), f"{prefix}_{name}.png")
             for name in drawn}
 
 
