@@ -5,6 +5,8 @@
     result = oceanmc.simulate(config)
     result["Ed"], result.stderr("Ed")
     result.save("out.h5"); oceanmc.load_result("out.h5")
+    oceanmc.derive(result)["Kd"].value                          # Kd, R, Q, t_up, ...
+    oceanmc.merge_results([result, other])                     # runs of one scene, other seeds
     lut = oceanmc.sweep("lut.yaml", "lut.nc", workers=2)      # an xarray.Dataset
 
 The names below are imported on first use (PEP 562), so that `import oceanmc` and commands that
@@ -22,17 +24,21 @@ _LAZY = {
     "Result": "run.result",
     "load_result": "run.hdf5",
     "simulate": "run.simulation",
+    "derive": "run.derived",
+    "merge_results": "run.merge",
     "sweep": "sweeps",
 }
 # the subpackages, as attributes (the data flow: config -> scene -> kernel -> run -> sweeps)
 _SUBMODULES = frozenset({"config", "registry", "scene", "kernel", "run", "sweeps"})
 
 __all__ = ["ConfigError", "SceneConfig", "Result", "load_config", "load_result", "simulate",
-           "sweep", "__version__"]
+           "derive", "merge_results", "sweep", "__version__"]
 
 if TYPE_CHECKING:
     from .config import ConfigError, SceneConfig, load_config
+    from .run.derived import derive
     from .run.hdf5 import load_result
+    from .run.merge import merge_results
     from .run.result import Result
     from .run.simulation import simulate
     from .sweeps import sweep

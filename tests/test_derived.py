@@ -101,9 +101,11 @@ def test_t_up_is_the_ratio_of_the_batch_means():
     assert t_up.stderr == pytest.approx(jackknife(lambda a, b: a / b, leaving, eu)[1], rel=1e-14)
     assert 0.3 < t_up.value < 0.7   # about 0.5 for diffuse upwelling light (Mobley 1994, 4.3)
     for name in ("t_up", "air/t_up", "Kd", "derived/Q"):
-        with pytest.raises(KeyError, match=r"derived from the batch means: oceanmc\.run\."
-                                           r"derived\.derive\(result\)"):
+        with pytest.raises(KeyError, match=r"derived from the batch means: "
+                                           r"oceanmc\.derive\(result\)"):
             result[name]
+    assert oceanmc.derive is derive and "t_up" in oceanmc.derive(result)
+    assert set(result.keys()) == set(result.quantities) and "air/Rrs_nadir" in result.keys()
 
 
 def test_a_zero_irradiance_leaves_a_quantity_undefined_not_infinite():

@@ -86,7 +86,10 @@ DERIVED_NAMES = tuple(name for name, _, _ in K_FUNCTIONS) + ("R", "Q", "mu_d", "
 
 
 def derive(result) -> dict[str, Derived]:
-    """Every derived quantity the result's tallies allow (none for a file without Ed)."""
+    """Every derived quantity the result's tallies allow, by name (none for a file without Ed):
+    Kd, Ku, Ko, KLu between adjacent tally depths, R, Q, mu_d, mu_u, mu at each tally depth,
+    t_up (with depth 0 tallied); each a Derived with .value, .stderr (the delete-one jackknife
+    over batches), .dims, .units, .description (the module's docstring says how)."""
     q = result.quantities
     if "Ed" not in q or q["Ed"].batches.shape[0] == 0:   # a partial file with no whole batch
         return {}

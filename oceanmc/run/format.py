@@ -155,7 +155,7 @@ def _write_iops(group: h5py.Group, iops: dict[str, np.ndarray]) -> None:
     thickness.dims[0].attach_scale(group["layer_top"])
     for name, description in IOPS_VALUES.items():
         ds = group.create_dataset(name, data=iops[name])
-        ds.attrs["units"], ds.attrs["description"] = "1/m", description
+        ds.attrs["units"], ds.attrs["description"] = "m-1", description
         ds.dims[0].attach_scale(group["layer_top"])
         ds.dims[1].attach_scale(group["wavelength"])
     if "bottom_reflectance" in iops:

@@ -48,6 +48,15 @@ class Quantity:
 
 @dataclass
 class Result:
+    """A run's quantities (oceanmc.simulate's, or a results file's: oceanmc.load_result).
+
+    result["Ed"] is a quantity's estimate (the mean over batches), result.stderr("Ed") its
+    standard error, result.keys() their names ("Ed", "air/Rrs_nadir", "raman/Lu", ...; the
+    README's Outputs), result.quantities[name].batches the per-batch values, result.coords the
+    coordinates (depth, theta, phi, wavelength, ...), result.attrs what the run was (its scene
+    as config_yaml, photons, seed, timing). The derived quantities (Kd, R, Q, t_up, ...) are
+    computed from the batch means: oceanmc.derive(result). result.save(path) writes the file
+    that `oceanmc show` and `plot` read and xarray opens."""
     coords: dict[str, np.ndarray]
     quantities: dict[str, Quantity]
     attrs: dict[str, object] = field(default_factory=dict)
@@ -64,7 +73,12 @@ class Result:
     def __contains__(self, name: str) -> bool:
         return name in self.quantities
 
+    def keys(self):
+        """The names of the quantities, as result[name] takes them."""
+        return self.quantities.keys()
+
     def stderr(self, name: str) -> np.ndarray:
+        """The standard error of quantity `name` over the batches (the estimate: result[name])."""
         return self._quantity(name).stderr
 
     def _quantity(self, name: str) -> Quantity:
@@ -79,7 +93,7 @@ class Result:
         if str(name).startswith("derived/") or leaf in DERIVED_NAMES:
             # the results file's group derived is computed from the batches, not held here
             hint = (f"; {leaf} is derived from the batch means: "
-                    f"oceanmc.run.derived.derive(result)[{leaf!r}] (.value, .stderr), or the "
+                    f"oceanmc.derive(result)[{leaf!r}] (.value, .stderr), or the "
                     "results file's group derived")
         raise KeyError(f"no quantity {name!r} in this result{hint}")
 

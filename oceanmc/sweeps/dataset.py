@@ -13,6 +13,7 @@ grid is every wavelength some point traces, with `wavelength_traced` per point (
 inelastic light makes points trace other grids)."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -118,6 +119,24 @@ class PointStore:
         return summary
 
 
+# the units of a scene key by the end of its name (the config's keys carry them: thickness_m,
+# sun_zenith_deg, chl_mg_m3, wind_speed_m_s), longest first, and of the IOP coefficients,
+# which do not; an axis coordinate gets them as its CF `units` (a user's review: ncview and
+# Panoply showed the axes without)
+UNIT_SUFFIXES = (("_mg_m3", "mg m-3"), ("_atm_cm", "atm-cm"), ("_m_s", "m s-1"),
+                 ("_deg", "degree"), ("_nm", "nm"), ("_pa", "Pa"), ("_cm", "cm"), ("_m", "m"))
+COEFFICIENT_KEYS = frozenset({"a", "b", "bb", "c", "a440", "a443", "b550"})
+
+
+def key_units(key: str) -> str | None:
+    """The units of the scene key at path `key` (water.layers[0].thickness_m: m), or None
+    where its name does not say (a reflectance, a count, a model's name)."""
+    name = re.sub(r"\[\d+\]", "", key).rpartition(".")[2]
+    if name in COEFFICIENT_KEYS:
+        return "m-1"
+    return next((units for suffix, units in UNIT_SUFFIXES if name.endswith(suffix)), None)
+
+
 def variable_name(quantity: str) -> str:
     """`air/Rrs_nadir` -> `air_Rrs_nadir`: one flat dataset (a '/' would mean a group)."""
     return quantity.replace("/", "_")
@@ -134,9 +153,11 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     coords: dict[str, tuple] = {}
     for axis in spec.axes:
         for name, key, values in zip(axis.names, axis.keys, axis.values):
-            coords[name] = (axis.dim, coordinate(values),
+            values = coordinate(values)
+            units = key_units(key) if values.dtype.kind in "if" else None
+            coords[name] = (axis.dim, values,
                             {"description": f"the scene's {key} along this axis",
-                             "key_path": key})
+                             "key_path": key} | ({"units": units} if units else {}))
     status = np.full(shape, PENDING, dtype=object)
     error = np.full(shape, "", dtype=object)
     photons = np.zeros(shape, dtype=np.int64)
