@@ -307,7 +307,7 @@ def cmd_merge(args: argparse.Namespace) -> int:
         raise UsageError(f"cannot merge: {exc}") from None
     merged.save(out, overwrite=args.overwrite)
     print(format_summary(merged))
-    print(f"  merged {len(parts)} runs (seeds {merged.attrs['seeds']}) into {out}")
+    print(f"  wrote {out}")
     return 0
 
 

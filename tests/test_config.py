@@ -155,7 +155,7 @@ def test_bad_values_name_key_value_and_allowed(small_scene, change, key, fragmen
      "config: wavelengths_nm = 550: allowed: a list or a mapping {start, stop, step}"),
     (lambda s: s["illumination"].update(sky="harrison-coombes"),
      "config: illumination.sky = 'harrison-coombes': allowed: 'uniform', 'cardioidal', "
-     "'overcast', 'harrison_coombes' or a mapping {map}"),
+     "'overcast', 'harrison_coombes' or a mapping {map} (did you mean 'harrison_coombes'?)"),
     # a non-number where a number or another form is allowed: not the number's range alone
     (lambda s: s["bottom"].update(reflectance="x"),
      "config: bottom.reflectance = 'x': expected a number or a list or a mapping {file}"),
@@ -256,6 +256,12 @@ def test_a_number_out_of_range_names_the_range_the_key_allows(tmp_path, small_sc
      "[180, 0], [180, 0], [180, ...: allowed: at most 64 items (found 65)"),
     (lambda s: s["tallies"].update(radiance="maybe"),
      "tallies.radiance = 'maybe': allowed: true or false"),
+    # a word or a list of a union's members (the code review of the change)
+    (lambda s: s["illumination"].update(sky="unifrom"),
+     "illumination.sky = 'unifrom': allowed: 'uniform', 'cardioidal', 'overcast', "
+     "'harrison_coombes' or a mapping {map} (did you mean 'uniform'?)"),
+    (lambda s: s.update(wavelengths_nm=[]), "wavelengths_nm = []: allowed: at least 1 item "
+     "(found 0)"),
 ])
 def test_a_word_not_allowed_is_answered_with_the_words_allowed(small_scene, change, message):
     """One of a few words misspelt was refused in pydantic's words ("surface.model =

@@ -105,6 +105,17 @@ def test_t_up_is_the_ratio_of_the_batch_means():
                                            r"oceanmc\.derive\(result\)"):
             result[name]
     assert oceanmc.derive is derive and "t_up" in oceanmc.derive(result)
+    result.attrs["inelastic_parts"] = "elastic raman"   # (as a run with Raman light says)
+    with pytest.raises(KeyError, match="raman/Kd.*derived from the whole light's batch means"):
+        result["raman/Kd"]
+    with pytest.raises(KeyError, match="the derived quantities are Kd, Ku"):
+        result["derived/K"]
+    deep = scene(photons=16 * 100)
+    deep["tallies"]["depths_m"] = [2.0]     # no depth 0: no t_up, one depth: no Kd
+    deep = oceanmc.simulate(deep, threads=2)
+    for name in ("t_up", "Kd"):
+        with pytest.raises(KeyError, match="this result's tallies do not give it"):
+            deep[name]
     assert set(result.keys()) == set(result.quantities) and "air/Rrs_nadir" in result.keys()
 
 

@@ -319,7 +319,8 @@ def test_a_partial_file_says_so_in_every_figure(mono_file, tmp_path):
             close(fig)
 
 
-def test_a_notebook_s_figures_refuse_what_they_cannot_draw_in_one_line(mono_file, tmp_path):
+def test_a_notebook_s_figures_refuse_what_they_cannot_draw_in_one_line(mono_file, spectral_file,
+                                                                      tmp_path):
     """From a notebook (a user's review): a file with no whole batch gave a blank figure and a
     numpy warning, radiance_figure's depth in metres numpy's IndexError, and something other
     than a file AttributeError; each is a PlotInputError saying what the figures take."""
@@ -341,6 +342,18 @@ def test_a_notebook_s_figures_refuse_what_they_cannot_draw_in_one_line(mono_file
             radiance_figure(mono_file, depth=depth)
     with pytest.raises(PlotInputError, match="dict: the figures take a results file's path"):
         rrs_figure({"air": None})
+    # a wavelength index for a monochromatic file, or one a spectral file lacks
+    from oceanmc.plot.results import profiles_figure
+    for call in (lambda: radiance_figure(mono_file, wavelength=0),
+                 lambda: profiles_figure(mono_file, indices=[0])):
+        with pytest.raises(PlotInputError, match="wavelength = 0: mono.h5 holds one wavelength"):
+            call()
+    a_result = load_result(mono_file)
+    with pytest.raises(PlotInputError, match="the Result of .* holds one wavelength"):
+        radiance_figure(a_result, wavelength=0)
+    with pytest.raises(PlotInputError, match=r"wavelength = 99: the index of one of the file's "
+                                             r"wavelengths, an integer 0 \.\. "):
+        profiles_figure(spectral_file, indices=[0, 99])
 
 
 LONG_NAME = ("clear oligotrophic water with Petzold particles and a Fournier-Forand tail over "

@@ -449,12 +449,13 @@ def test_a_failing_point_is_recorded_and_the_others_run(tmp_path, monkeypatch, t
 
 
 def test_an_axis_s_units_come_from_its_key_s_name():
-    from oceanmc.sweeps.dataset import key_units
-    assert [key_units(k) for k in (
+    from oceanmc.sweeps.dataset import axis_units
+    assert [axis_units(k) for k in (
         "water.layers[0].thickness_m", "illumination.sun_zenith_deg", "surface.wind_speed_m_s",
         "water.layers[0].components[1].chl_mg_m3", "water.layers[2].b", "bottom.reflectance",
-        "photons", "illumination.spectrum.ozone_atm_cm")] == [
-        "m", "degree", "m s-1", "mg m-3", "m-1", None, None, "atm-cm"]
+        "photons", "illumination.spectrum.ozone_atm_cm", "water.inelastic.raman.b488_per_m",
+        "illumination.spectrum.surface_pressure_pa")] == [
+        "m", "degree", "m s-1", "mg m-3", "m-1", None, None, "atm-cm", "m-1", "Pa"]
 
 
 # --- a scheduler and two workers as separate processes; one killed mid-sweep ----------------

@@ -299,6 +299,21 @@ Coefficient = Annotated[float, Field(ge=0.0, le=MAX_COEFFICIENT, allow_inf_nan=F
 # (c x thickness) without meaning anything.
 MAX_THICKNESS_M = 1e6
 Fraction = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
+# the units a scene key's name ends with (thickness_m, sun_zenith_deg, chl_mg_m3,
+# wind_speed_m_s, b488_per_m), in CF's spelling, longest first where one ends another; and the
+# IOP coefficients, whose names do not say them
+UNIT_SUFFIXES = (("_per_m", "m-1"), ("_mg_m3", "mg m-3"), ("_atm_cm", "atm-cm"),
+                 ("_m_s", "m s-1"), ("_deg", "degree"), ("_nm", "nm"), ("_pa", "Pa"),
+                 ("_cm", "cm"), ("_m", "m"))
+COEFFICIENT_KEYS = frozenset({"a", "b", "bb", "c", "a440", "a443", "b550"})
+
+
+def key_units(name: str) -> str | None:
+    """The units of the scene key `name` (its last path element: thickness_m -> m), or None
+    where its name does not say (a reflectance, a count, a model's name)."""
+    if name in COEFFICIENT_KEYS:
+        return "m-1"
+    return next((units for suffix, units in UNIT_SUFFIXES if name.endswith(suffix)), None)
 # An asymmetry parameter (Henyey-Greenstein g, the Hapke grains', SPECTRL2's aerosols'): within
 # 1e-6 of +-1, as nothing natural comes near; closer, the computations lose all precision (a
 # Henyey-Greenstein g of 1 - 1e-10 gave NaN local estimates, SPECTRL2's aerosol factor of

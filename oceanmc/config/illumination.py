@@ -41,7 +41,6 @@ class SkyMap(_Strict):
         return self
 
 
-
 SPA_LAST_YEAR = 6000
 
 

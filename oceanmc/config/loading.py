@@ -20,8 +20,8 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, Tag, ValidationError
 
-from .base import (QUOTED_NUMBER, SHOWN_VALUE, ConfigError, _items, _Strict, allowed_numbers,
-                   too_long_integer)
+from .base import (QUOTED_NUMBER, SHOWN_VALUE, UNIT_SUFFIXES, ConfigError, _items, _Strict,
+                   allowed_numbers, too_long_integer)
 from .bottom import ReflectanceSpectrum, TableBottom, reflectance_keys
 from .illumination import SkyMap
 from .phase import Mixture, TablePhase
@@ -269,7 +269,7 @@ def _key_path(loc: tuple) -> str:
 
 # a key's unit, left out when a misspelt key is matched (`chl: 1` or `b488: 3e-4`: the quantity
 # without its unit is close to none of the keys with it)
-_UNIT_SUFFIX = re.compile(r"_(per_m|mg_m3|m_s|deg|nm|m|atm_cm|pa)$")
+_UNIT_SUFFIX = re.compile("(" + "|".join(suffix for suffix, _ in UNIT_SUFFIXES) + ")$")
 
 
 def _closest(key: str, names) -> str | None:
@@ -418,7 +418,7 @@ def _describe(error: dict) -> str:
         return msg
     loc = tuple(error.get("loc", ()))
     forms = _union_forms(loc)
-    if kind in _LENGTH_ERRORS and not forms:
+    if kind in _LENGTH_ERRORS:   # (a list member of a union too: wavelengths_nm: [])
         # a list of too few or too many (water.layers: []): pydantic's 'List should have at
         # least 1 item after validation, not 0' in the house words
         count = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
@@ -443,6 +443,8 @@ def _describe(error: dict) -> str:
             msg = f"allowed: {allowed}"
         elif expected:
             msg = f"expected {expected}"
+        if kind == "literal_error":   # a word of a union's (illumination.sky: unifrom)
+            msg += _nearest_word(error.get("input"), str(ctx.get("expected", "")))
     if "input" in error and not isinstance(error["input"], dict):
         shown = _shown(error["input"])
         if len(shown) > 80:
@@ -454,8 +456,6 @@ def _describe(error: dict) -> str:
 def _nearest_word(value: object, expected: str) -> str:
     """' (did you mean 'cox_munk'?)' where `value` is a misspelling of one of the quoted words
     of pydantic's `expected` ("'flat', 'none' or 'cox_munk'"); '' otherwise."""
-    import difflib
-    import re
     if not isinstance(value, str):
         return ""
     words = re.findall(r"'([^']*)'", expected)

@@ -161,8 +161,12 @@ def opened(result) -> ResultFile:
     stopped before its first) is a PlotInputError, as `oceanmc plot` refuses it."""
     from ..run.result import Result
     if isinstance(result, Result):
+        # (named after its scene in what the figures and their messages say: the file is gone)
         with tempfile.TemporaryDirectory(prefix="oceanmc-plot-") as folder:
-            return opened(result.save(Path(folder) / "result.h5"))
+            file = opened(result.save(Path(folder) / "result.h5"))
+        scene = str(result.attrs.get("name") or "a run").replace("/", "-")
+        file.path = Path(f"the Result of {scene!r}")
+        return file
     if isinstance(result, (str, Path)):
         result = open_result(result)
     if not isinstance(result, ResultFile):
@@ -314,6 +318,8 @@ def profiles_figure(result: ResultFile | str | Path, indices: list[int] | None =
     result = opened(result)
     if indices is None:
         indices = wavelength_indices(result, None)
+    for index in indices:
+        _check_wavelength(result, index)
     fig, axes = panels(len(PROFILE_QUANTITIES), 3, (4.2, 4.6))
     lines = indices or [None]
     colours = _wavelength_colours(result, lines)
@@ -372,9 +378,8 @@ def radiance_figure(result: ResultFile | str | Path, depth: int = 0,
     if "radiance" not in result.water:
         return None
     _check_index("depth", depth, result.depths, "m", "--depth in metres")
-    if result.wavelengths is not None:
-        _check_index("wavelength", wavelength, result.wavelengths, "nm",
-                     "--wavelength in nm")
+    if wavelength is not None:
+        _check_wavelength(result, wavelength)
     theta_edges = np.asarray(result.water.coords["theta_edges"], dtype=np.float64)
     phi_edges = np.asarray(result.water.coords["phi_edges"], dtype=np.float64)
     rows = [(f"{result.depths[depth]:g} m" + (" (0-)" if result.depths[depth] == 0 else ""),
@@ -412,6 +417,15 @@ def _check_index(name: str, index, values: np.ndarray, units: str, command: str)
         raise PlotInputError(f"{name} = {index!r}: the index of one of the file's {name}s, an "
                              f"integer 0 .. {len(values) - 1} ({units}: {_listed(values)}); "
                              f"`oceanmc plot` takes {command}")
+
+
+def _check_wavelength(result: ResultFile, index) -> None:
+    """A wavelength index the figure functions take: one of a spectral file's; a monochromatic
+    file takes none (its quantities have no wavelength dimension)."""
+    if result.wavelengths is None:
+        raise PlotInputError(f"wavelength = {index!r}: {result.path.name} holds one wavelength "
+                             "and no wavelength dimension; leave the wavelength index out")
+    _check_index("wavelength", index, result.wavelengths, "nm", "--wavelength in nm")
 
 
 # the quantity each figure needs, for the note when a file lacks it

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .derived import DERIVED_NAMES
+from .derived import DERIVED_NAMES, derive
 from .format import save_result
 
 
@@ -91,11 +91,24 @@ class Result:
             difflib.get_close_matches(str(name), list(self.quantities), n=3, cutoff=0.6)
         hint = f"; did you mean {' or '.join(near)}?" if near else ""
         if str(name).startswith("derived/") or leaf in DERIVED_NAMES:
-            # the results file's group derived is computed from the batches, not held here
-            hint = (f"; {leaf} is derived from the batch means: "
-                    f"oceanmc.derive(result)[{leaf!r}] (.value, .stderr), or the "
-                    "results file's group derived")
+            hint = self._derived_hint(str(name), leaf)
         raise KeyError(f"no quantity {name!r} in this result{hint}")
+
+    def _derived_hint(self, name: str, leaf: str) -> str:
+        """Where a derived quantity (the results file's group derived, computed from the
+        batches, not held here) is, or why this result has none of that name."""
+        if leaf not in DERIVED_NAMES:
+            return f"; the derived quantities are {', '.join(DERIVED_NAMES)}"
+        if name.partition("/")[0] in str(self.attrs.get("inelastic_parts", "")).split():
+            # raman/Kd
+            return (f"; {leaf} is derived from the whole light's batch means only: "
+                    f"oceanmc.derive(result)[{leaf!r}]")
+        if leaf not in derive(self):
+            return (f"; {leaf} is derived from the batch means, and this result's tallies do "
+                    "not give it (t_up needs depth 0 tallied, a K function two tally depths, "
+                    "KLu and Q the nadir radiance Lu)")
+        return (f"; {leaf} is derived from the batch means: oceanmc.derive(result)[{leaf!r}] "
+                "(.value, .stderr), or the results file's group derived")
 
     def __repr__(self) -> str:
         # (the dataclass's own repr printed every batch of every quantity: 67,000 characters

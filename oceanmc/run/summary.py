@@ -86,9 +86,7 @@ def estimator_lines(result: Result) -> list[str]:
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, local (next-event) estimate"
                         + (" (air/Rrs_nadir_crossing: the crossing estimate)"
                            if "air/Rrs_nadir_crossing" in result else "")
-                        + ("" if result.attrs.get("upward_fraction", 0) else
-                           UNBIASED_SPECTRAL_CAP if "wavelength" in result.coords else
-                           UNBIASED_CAP))
+                        + (UNBIASED_SPECTRAL_CAP if unbiased_local_nadir(result) else ""))
         else:
             said.append(f"Rrs nadir: air/Rrs_nadir, {cap}, crossing estimate (photons leaving "
                         f"through the cap{local_nadir_hint(result)})")
@@ -120,6 +118,15 @@ UNBIASED_SPECTRAL_CAP = ("; without upward-biased scattering (estimator.upward_f
 UNBIASED_CAP = ("; without upward-biased scattering its variance comes from the few packets "
                 "travelling near straight up: estimator.upward_fraction: 0.1 (implicit walk) "
                 "gives it several to tens of times the figure of merit")
+
+
+def unbiased_local_nadir(result: Result) -> bool:
+    """Rrs nadir is the local estimate, in scattering water, without upward-biased scattering
+    (UNBIASED_SPECTRAL_CAP, UNBIASED_CAP); water that does not scatter has no such variance
+    (a user's review: the note was printed for configs/snell_window.yaml)."""
+    scatters = "b" not in result.iops or bool(np.any(np.asarray(result.iops["b"]) > 0.0))
+    return "air/Rrs_nadir" in result and nadir_estimate(result) == "local" and scatters \
+        and not result.attrs.get("upward_fraction", 0)
 
 
 def local_nadir_hint(result: Result) -> str:
@@ -505,9 +512,7 @@ def format_summary(result: Result) -> str:
     for label, units, value, err in summary_rows(result):
         rel = abs(err / value) if value != 0.0 else 0.0
         lines.append(f"  {label:<28}{units:<9}{value:>13.6g}{err:>12.3g}{rel:>10.2%}")
-    scatters = "b" not in result.iops or np.any(np.asarray(result.iops["b"]) > 0.0)
-    if "air/Rrs_nadir" in result and nadir_estimate(result) == "local" and scatters \
-            and not result.attrs.get("upward_fraction", 0):
+    if unbiased_local_nadir(result):
         lines += textwrap.wrap("note: Rrs nadir (local)" + UNBIASED_CAP, 100,
                                initial_indent="  ", subsequent_indent="    ")
     return "\n".join(lines)

@@ -21,6 +21,7 @@ import numpy as np
 import yaml
 
 from .. import __version__
+from ..config.base import key_units
 from ..run.derived import COORDS as DERIVED_COORDS
 from ..run.derived import derive, intervals
 from ..run.format import COORD_UNITS, SWEEP_TITLE
@@ -119,22 +120,11 @@ class PointStore:
         return summary
 
 
-# the units of a scene key by the end of its name (the config's keys carry them: thickness_m,
-# sun_zenith_deg, chl_mg_m3, wind_speed_m_s), longest first, and of the IOP coefficients,
-# which do not; an axis coordinate gets them as its CF `units` (a user's review: ncview and
-# Panoply showed the axes without)
-UNIT_SUFFIXES = (("_mg_m3", "mg m-3"), ("_atm_cm", "atm-cm"), ("_m_s", "m s-1"),
-                 ("_deg", "degree"), ("_nm", "nm"), ("_pa", "Pa"), ("_cm", "cm"), ("_m", "m"))
-COEFFICIENT_KEYS = frozenset({"a", "b", "bb", "c", "a440", "a443", "b550"})
-
-
-def key_units(key: str) -> str | None:
-    """The units of the scene key at path `key` (water.layers[0].thickness_m: m), or None
-    where its name does not say (a reflectance, a count, a model's name)."""
-    name = re.sub(r"\[\d+\]", "", key).rpartition(".")[2]
-    if name in COEFFICIENT_KEYS:
-        return "m-1"
-    return next((units for suffix, units in UNIT_SUFFIXES if name.endswith(suffix)), None)
+def axis_units(key: str) -> str | None:
+    """The CF units of an axis over the scene key at path `key` (water.layers[0].thickness_m:
+    m; config.base.key_units), or None where its name does not say (a user's review: ncview
+    and Panoply showed the axes without)."""
+    return key_units(re.sub(r"\[\d+\]", "", key).rpartition(".")[2])
 
 
 def variable_name(quantity: str) -> str:
@@ -154,7 +144,7 @@ def assemble(spec: SweepSpec, points: list[Point], summaries: dict[str, Summary]
     for axis in spec.axes:
         for name, key, values in zip(axis.names, axis.keys, axis.values):
             values = coordinate(values)
-            units = key_units(key) if values.dtype.kind in "if" else None
+            units = axis_units(key) if values.dtype.kind in "if" else None
             coords[name] = (axis.dim, values,
                             {"description": f"the scene's {key} along this axis",
                              "key_path": key} | ({"units": units} if units else {}))

@@ -99,14 +99,18 @@ def local_client(workers: int):
     listening on 127.0.0.1 only. Its dashboard is off; the scheduler's other HTTP routes
     (health, metrics) listen on a free port of 127.0.0.1: left to distributed, they took port
     8787 of every interface, and where a user's own Dask dashboard held it, distributed warned
-    'Port 8787 is already in use' (a UserWarning, which `-W error` makes a failed start)."""
+    'Port 8787 is already in use' (a UserWarning, which `-W error` makes a failed start).
+    Its processes log only CRITICAL: at ERROR, a worker whose heartbeat met the scheduler
+    already closing printed 'Failed to communicate with scheduler during heartbeat' and a
+    25-line CommClosedError traceback after a sweep that had finished (a fresh clone's CI, and
+    a user's SIGTERM); a point that fails is reported by the sweep itself (status, error)."""
     import logging
 
     from distributed import Client, LocalCluster
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                       host="127.0.0.1", dashboard_address=None,
                       scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+                      silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:
         yield client
 
 
