@@ -195,6 +195,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .run.simulation import NonFiniteResult, prepare, simulate
     from .run.summary import format_summary
 
+    if args.resume and args.overwrite:   # (together it started over, silently: a review)
+        raise UsageError("--resume and --overwrite together: --resume continues a partial "
+                         "file, --overwrite replaces it with a new run; give one of them")
     configs = [Path(c) for c in args.configs]
     outputs = _outputs(configs, args.output)
     if len(set(outputs)) != len(outputs):
@@ -300,7 +303,10 @@ def cmd_merge(args: argparse.Namespace) -> int:
             parts.append(load_result(path))
         except ValueError as exc:  # ResultsFileError: one line saying what is wrong
             raise UsageError(f"{path}: {exc}") from None
-    _check_writable(out, args.overwrite, resumable=False)
+    # the merged file holds every input's batches: about their files' sizes together (on a
+    # full disk h5py's write failed in C, 1300 lines of tracebacks and a segfault: a review)
+    _check_writable(out, args.overwrite, sum(Path(name).stat().st_size for name in args.files),
+                    resumable=False)
     try:
         merged = merge_results(parts)
     except MergeError as exc:

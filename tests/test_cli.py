@@ -461,3 +461,35 @@ def test_two_configs_that_would_write_one_file_are_named(tmp_path, small_scene):
     done = oceanmc("run", "a/s.yaml", "b/s.yaml", "-o", "out/", cwd=tmp_path)
     assert done.returncode == 2
     assert "a/s.yaml and b/s.yaml would both write out/s.h5" in done.stderr, done.stderr
+
+
+def test_merge_onto_a_disk_without_room_is_refused_before_writing(tmp_path, small_scene,
+                                                                    monkeypatch, capsys):
+    """merge wrote onto a full disk until h5py's write failed in C (1300 lines of tracebacks
+    and a segfault: a user's review); like run, it now checks the room first: the inputs'
+    sizes together, twice over, in one line, exit 2, nothing written."""
+    import shutil
+
+    import oceanmc
+    from oceanmc.cli import main
+    a = oceanmc.simulate(dict(small_scene, seed=1), threads=1).save(tmp_path / "a.h5")
+    b = oceanmc.simulate(dict(small_scene, seed=2), threads=1).save(tmp_path / "b.h5")
+    need = a.stat().st_size + b.stat().st_size
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage",
+                        lambda folder: usage._replace(free=need))   # less than twice over
+    assert main(["merge", str(a), str(b), "-o", str(tmp_path / "ab.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("oceanmc: error: not enough disk space in ") and err.count("\n") == 1
+    assert not (tmp_path / "ab.h5").exists()
+
+
+def test_resume_and_overwrite_together_are_refused(tmp_path, scene_file, capsys):
+    """`--resume --overwrite` started the run over and dropped the partial file's batches
+    without a word (a user's review): the two ask opposite things; one line, exit 2."""
+    from oceanmc.cli import main
+    assert main(["run", str(scene_file), "-o", str(tmp_path / "r.h5"), "--resume",
+                 "--overwrite"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("oceanmc: error: --resume and --overwrite together: --resume continues a "
+                   "partial file, --overwrite replaces it with a new run; give one of them\n")

@@ -46,6 +46,26 @@ def test_two_racing_writers_one_wins_other_kept(tmp_path):
     assert not list(tmp_path.glob(".*.tmp"))
 
 
+def test_a_run_whose_new_file_another_run_made_meanwhile_keeps_its_results(tmp_path,
+                                                                           small_scene):
+    """Two runs to one new file: the second's end met the first's file and lost its results
+    with a FileExistsError traceback (Result.save's refusal comes before writing; a user's
+    review). A run's file (run/resume.RunFile) is placed atomically instead: the results are
+    kept beside it and the message says where; the other run's file is untouched."""
+    import oceanmc
+    from oceanmc.run.hdf5 import load_result
+    from oceanmc.run.resume import RunFile
+    target = tmp_path / "same.h5"
+    first = oceanmc.simulate(dict(small_scene, seed=1), threads=1).save(target)
+    before = target.read_bytes()
+    result = oceanmc.simulate(dict(small_scene, seed=2), threads=1)
+    with pytest.raises(ResultsSavedElsewhere, match="another process created this file") as info:
+        RunFile(target, None, overwrite=False).save(result)
+    assert first.read_bytes() == before
+    kept = load_result(info.value.kept)
+    np.testing.assert_array_equal(kept.quantities["Ed"].batches, result.quantities["Ed"].batches)
+
+
 def test_overwrite_replaces(tmp_path):
     target = tmp_path / "out.h5"
     place_atomically(target, _writer(1.0), overwrite=False)

@@ -317,6 +317,27 @@ def test_a_resume_state_that_is_not_a_partial_results_is_refused(small_scene, ju
         oceanmc.simulate(small_scene, resume_state=junk)
 
 
+@pytest.mark.parametrize("damage, said", [
+    (lambda s: s["next_photon"].__setitem__(0, -3), "next photon outside -1 .. 10000"),
+    (lambda s: s["next_photon"].__setitem__(0, 99999), "next photon outside -1 .. 10000"),
+    (lambda s: s["rng"].__setitem__(0, 0), "a random stream of all zeros"),
+    (lambda s: s["beam"].__setitem__(0, 5.0), "an entered sun beam without a finite weight "
+                                              "and a unit direction"),
+    (lambda s: s["events"].__setitem__(0, -1), "negative scattering events"),
+])
+def test_a_damaged_stored_state_is_refused_not_resumed(small_scene, monkeypatch, damage, said):
+    """A partial file's unfinished batches edited by hand (a user's review: next_photon -3 or
+    99999 and a zero random stream resumed with exit status 0 and wrong tallies, beam = 5
+    crashed the process): refused in one line before any photon is traced."""
+    small_scene.update(photons=20000, batches=2)
+    part = stopped_run(small_scene, monkeypatch, 0.001, 0)
+    state = {key: np.array(values) for key, values in part.resume_state.items()}
+    damage(state)
+    with pytest.raises(MergeError, match=f"the stored unfinished batches are damaged \\({said}"):
+        oceanmc.simulate(small_scene, threads=1, resume_state=state)
+    assert oceanmc.simulate(small_scene, threads=1, resume_state=part.resume_state)
+
+
 def test_resume_with_other_command_line_counts_says_which_options_to_give(tmp_path, small_scene,
                                                                            monkeypatch):
     """A partial file run with --photons N, resumed without it, is refused with the option to

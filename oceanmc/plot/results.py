@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..config.loading import file_problem
-from ..run.format import SWEEP_DATASET_MESSAGE, SWEEP_TITLE
+from ..run.format import FORMAT_VERSION, SWEEP_DATASET_MESSAGE, SWEEP_TITLE
 from ..run.results import PART_LABELS
 from ..run.summary import planned_batches
 from . import fit_title, log_norm, panels, polar_quads, pyplot, save
@@ -67,7 +67,7 @@ def open_result(path: str | Path) -> ResultFile:
         raise PlotInputError(f"{path}: {problem}")
     try:
         water = xr.load_dataset(path, engine="h5netcdf", phony_dims="access")
-    except (OSError, ValueError) as exc:
+    except UNREADABLE as exc:
         raise PlotInputError(f"{path}: not an oceanmc results file (not readable as HDF5: "
                              f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__})"
                              ) from None
@@ -76,22 +76,34 @@ def open_result(path: str | Path) -> ResultFile:
     if "format_version" not in water.attrs or "Ed" not in water:
         raise PlotInputError(f"{path}: not an oceanmc results file (no format_version attribute "
                              "or no Ed)")
+    version = water.attrs["format_version"]
+    if version != FORMAT_VERSION:   # (as show, merge and --resume refuse it: a review)
+        raise PlotInputError(f"{path}: format_version {version!r}; this oceanmc reads "
+                             f"format_version {FORMAT_VERSION}")
+    if not str(water.attrs.get("batches", "")).isdigit():
+        raise PlotInputError(f"{path}: its attribute batches = "
+                             f"{water.attrs.get('batches')!r} is not a count of batches")
     try:
         air = xr.load_dataset(path, engine="h5netcdf", group="air")
-    except (OSError, ValueError):
+    except UNREADABLE:
         raise PlotInputError(f"{path}: not an oceanmc results file (no group air)") from None
     try:
         derived = xr.load_dataset(path, engine="h5netcdf", group="derived")
-    except (OSError, ValueError):   # written before oceanmc derived them, or no whole batch
+    except UNREADABLE:   # written before oceanmc derived them, or no whole batch
         derived = None
     names = str(water.attrs.get("inelastic_parts", "")).split()
     try:
         parts = {name: xr.load_dataset(path, engine="h5netcdf", group=f"{name}/air")
                  for name in names} if len(names) > 1 else {}
-    except (OSError, ValueError):
+    except UNREADABLE:
         raise PlotInputError(f"{path}: its attribute inelastic_parts names parts "
                              f"({', '.join(names)}) without their group PART/air") from None
     return ResultFile(water, air, path, derived, parts)
+
+
+# what xarray and h5netcdf raise for a file or group they cannot read: a damaged file's
+# metadata checksum gave RuntimeError or AttributeError (a user's review: tracebacks)
+UNREADABLE = (OSError, ValueError, KeyError, RuntimeError, AttributeError, TypeError)
 
 
 def _listed(values: np.ndarray, most: int = 12) -> str:

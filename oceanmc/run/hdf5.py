@@ -43,9 +43,12 @@ def load_result(path: str | Path) -> Result:
         raise
     except RecursionError:
         raise ResultsFileError("nested too deeply to be a results file") from None
-    except (OSError, KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+    except (OSError, KeyError, ValueError, TypeError, AttributeError, IndexError,
+            RuntimeError) as exc:
         # h5py reports a missing dataset, a dangling or external link, a truncated file as
-        # OSError/KeyError; a wrong dtype or shape surfaces as ValueError/TypeError below
+        # OSError/KeyError; a wrong dtype or shape surfaces as ValueError/TypeError below; a
+        # damaged one as RuntimeError ('Object visitation failed (incorrect metadata
+        # checksum)': a user's review, show, merge and --resume gave a traceback)
         detail = " ".join(str(exc).split()) or type(exc).__name__
         raise ResultsFileError(f"not an oceanmc results file ({detail[:200]})") from None
 

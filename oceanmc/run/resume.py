@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .format import save_result
 from .hdf5 import load_result
 from .merge import MergeError, check_resumable, check_same_data_files, merge_results, \
     scene_difference
@@ -89,12 +90,16 @@ class RunFile:
             merge_results([self.previous, result], resume=True)
 
     def checkpoint(self, partial: Result) -> None:
-        self.combined(partial).save(self.path, overwrite=self.replace)
+        save_result(self.combined(partial), self.path, self.replace)
         self.replace = self.checkpointed = True
 
     def save(self, result: Result) -> None:
-        """The run's end (a result already combined)."""
-        result.save(self.path, overwrite=self.replace)
+        """The run's end (a result already combined). Written by save_result, not Result.save,
+        whose refusal of an existing file comes before writing: a file another run made
+        meanwhile would have lost this run's results with a FileExistsError (a user's review,
+        two runs to one new file); place_atomically keeps them beside it instead
+        (ResultsSavedElsewhere)."""
+        save_result(result, self.path, self.replace)
 
     def discard(self) -> None:
         """Removes the file this run's checkpoints made, when its end is refused: a continued

@@ -257,6 +257,10 @@ class Batches:
             raise MergeError(f"the stored unfinished batches' {', '.join(uneven)} do not hold "
                              f"one row for each of their {count} batches: allowed a partial "
                              "Result's resume_state")
+        problem = self.state_problem(state)
+        if problem:
+            raise MergeError(f"the stored unfinished batches are damaged ({problem}): allowed "
+                             "a partial Result's resume_state")
         rows = np.zeros((count, self.tallies.shape[1]))
         try:
             write_tally_arrays(self.grid, {key.removeprefix("tally/"): values
@@ -277,6 +281,27 @@ class Batches:
             self.next_photon[b] = state["next_photon"][k]
             self.events[b] = state["events"][k]
             self.tallies[b] = rows[k]
+
+    def state_problem(self, state: dict[str, np.ndarray]) -> str:
+        """What in a stored state no run writes, '' if nothing: a photon count outside the
+        batch's, a random stream of all zeros (xoshiro's one degenerate state), an entered sun
+        beam of no finite weight or no unit direction, negative events. (Edited by hand, such
+        a state resumed with exit status 0 and wrong tallies, or a segfault: a user's
+        review.) The tallies so far cannot be checked this way: any finite values are some
+        run's."""
+        next_photon = np.asarray(state["next_photon"])
+        if np.any((next_photon < -1) | (next_photon > self.photons_per_batch)):
+            return f"next photon outside -1 .. {self.photons_per_batch}"
+        rng = np.asarray(state["rng"]).reshape(len(next_photon), -1)
+        if np.any(np.all(rng[:, :STATE_WORDS] == 0, axis=1)):
+            return "a random stream of all zeros"
+        beam = np.asarray(state["beam"], dtype=np.float64).reshape(len(next_photon), -1)
+        if beam.shape[1] != 4 or not np.all(np.isfinite(beam)) or np.any(beam[:, 0] < 0.0) \
+                or np.any(np.abs(np.sum(beam[:, 1:] ** 2, axis=1) - 1.0) > 1e-9):
+            return "an entered sun beam without a finite weight and a unit direction"
+        if np.any(np.asarray(state["events"]) < 0):
+            return "negative scattering events"
+        return ""
 
 
 def run_attrs(run: PreparedRun, batches: Batches, done: int, threads: int, wall: float,
