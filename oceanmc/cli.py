@@ -348,7 +348,10 @@ def cmd_plot(args: argparse.Namespace) -> int:
     except PlotInputError as exc:
         raise UsageError(str(exc)) from None
     except OSError as exc:
-        raise UsageError(f"-o {args.output}: cannot write the figures there ({exc})") from None
+        where = f"-o {args.output}" if args.output is not None else \
+            f"{Path(args.file).parent or Path('.')} (beside the results file; -o names another)"
+        raise UsageError(f"{where}: cannot write the figures there "
+                         f"({exc.strerror or exc})") from None
     for name, path in written.items():
         if isinstance(path, str):   # why it was not drawn
             print(f"oceanmc: plot: {args.file} {path}; no {name} figure", file=sys.stderr)

@@ -13,7 +13,6 @@ import oceanmc
 from oceanmc.cli import main
 from oceanmc.kernel.models import FLUX_EOD
 from oceanmc.run import derivation, simulation
-from oceanmc.run.results import Result
 from oceanmc.run.simulation import NonFiniteResult
 
 SPECTRAL = {"photons": 400, "batches": 4, "seed": 2, "wavelengths_nm": [400, 500, 600],
@@ -86,10 +85,11 @@ def test_a_checkpoint_written_before_the_fault_showed_is_removed(scene_file, mon
                                                                   capsys):
     """The fault only in the last batches: the checkpoints before it wrote a (finite, partial)
     file, which is removed when the end is refused."""
+    from oceanmc.run import resume
     saves = []
-    real_save = Result.save
-    monkeypatch.setattr(Result, "save", lambda self, path, overwrite=True: (
-        saves.append(self.attrs["batches"]), real_save(self, path, overwrite))[1])
+    real_save = resume.save_result     # (how a run's file is written: run/resume.RunFile)
+    monkeypatch.setattr(resume, "save_result", lambda result, path, overwrite=True: (
+        saves.append(result.attrs["batches"]), real_save(result, path, overwrite))[1])
     monkeypatch.setattr(simulation, "POLL_SECONDS", 0.01)
     batches = 8
     (scene_file).write_text(yaml.safe_dump(dict(SPECTRAL, photons=80_000, batches=batches)))

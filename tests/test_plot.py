@@ -405,3 +405,12 @@ def test_output_folder_with_or_without_a_trailing_separator(mono_file, tmp_path,
     assert sorted(p.name for p in tmp_path.glob("pic*")) == ["pic_profiles.png",
                                                             "pic_radiance.png", "pic_rrs.png"]
     capsys.readouterr()
+
+
+def test_a_device_as_the_figures_name_is_refused(mono_file, capsys):
+    """`plot -o /dev/full` took the device as a prefix and wrote /dev/full_rrs.png and the rest
+    into /dev (a user's review, as root): one line, exit 2, nothing written."""
+    before = set(os.listdir("/dev"))
+    err = one_line_error(capsys, ["plot", str(mono_file), "-o", "/dev/null"])
+    assert "-o /dev/null: not a folder or a name for the figures (it is a device" in err
+    assert set(os.listdir("/dev")) == before

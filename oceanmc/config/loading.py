@@ -155,7 +155,10 @@ def file_problem(path: str | Path) -> str | None:
         return "no such file"
     except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
         return f"cannot read it ({getattr(exc, 'strerror', None) or exc})"
-    return None if stat.S_ISREG(info.st_mode) else "not a regular file"
+    if not stat.S_ISREG(info.st_mode):
+        return "not a regular file"
+    # (its permissions: read as HDF5, it was 'not an oceanmc results file (Permission denied)')
+    return None if os.access(path, os.R_OK) else "cannot read it (permission denied)"
 
 
 def read_table_text(path: str | Path, origin: str) -> str:

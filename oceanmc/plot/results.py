@@ -80,7 +80,7 @@ def open_result(path: str | Path) -> ResultFile:
     if version != FORMAT_VERSION:   # (as show, merge and --resume refuse it: a review)
         raise PlotInputError(f"{path}: format_version {version!r}; this oceanmc reads "
                              f"format_version {FORMAT_VERSION}")
-    if not str(water.attrs.get("batches", "")).isdigit():
+    if "batches" in water.attrs and not str(water.attrs["batches"]).isdigit():
         raise PlotInputError(f"{path}: its attribute batches = "
                              f"{water.attrs.get('batches')!r} is not a count of batches")
     try:
@@ -537,5 +537,9 @@ def _prefix(path: Path, out: str | Path | None) -> Path:
     text = str(out)
     if text.endswith(("/", "\\")) or Path(text).is_dir():
         return Path(text) / path.stem
+    if Path(text).exists() and not Path(text).is_file():
+        # a device (-o /dev/full wrote /dev/full_rrs.png and the rest into /dev: a review)
+        raise PlotInputError(f"-o {text}: not a folder or a name for the figures (it is a "
+                             "device or another special file)")
     # a prefix given as a figure's name (-o pic.png): pic_rrs.png, not pic.png_rrs.png
     return Path(text[:-len(".png")] if text.lower().endswith(".png") else text)
