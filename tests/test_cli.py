@@ -408,6 +408,7 @@ def test_show_iops_prints_each_layer_s_iops_and_the_bottom(tmp_path, scene_file)
     assert "5 m to infinite depth" in text
     assert lines[7].split() == ["400", "0.3", "0", "0", "0.3", "nan", "0"]   # no scattering
     assert lines[-1].split() == ["500", "0.2"] and "reflectance" in lines[-3]
+    assert "a minnaert" in lines[-5] and max(map(len, lines)) <= 100   # what rho is, wrapped
     assert "holds none" in format_iops(Result({}, {}, {}, None, {}))
     # the command: a run's own file
     assert oceanmc("run", scene_file, "-o", "r.h5", "-q", cwd=tmp_path).returncode == 0

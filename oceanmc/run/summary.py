@@ -474,8 +474,8 @@ def format_iops(result: Result) -> str:
                            [a, b, bb, c, np.where(b > 0.0, bb / b, np.nan),
                             np.where(c > 0.0, b / c, np.nan)])
     if "bottom_reflectance" in iops:
-        lines.append("  bottom: its model's reflectance rho (a lambertian bottom's Eu/Ed; a "
-                     "minnaert bottom reflects 2 rho cos^k t_i / (k + 2))")
+        lines += ["  bottom: its model's reflectance rho (a lambertian bottom's Eu/Ed; a minnaert",
+                  "  bottom reflects 2 rho cos^k t_i / (k + 2))"]
         lines += table(["reflectance"], [np.atleast_1d(iops["bottom_reflectance"])])
     return "\n".join(lines)
 
