@@ -680,6 +680,12 @@ def one_line(text: str) -> str:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.func in (cmd_run, cmd_sweep) and signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        # a job a script started in the background inherits SIGINT as ignored; StopRequest
+        # takes it over once the run begins, and before that (reading the scenes, building
+        # their tables) `kill -INT` was dropped and the run went on to exit 0 (a user's
+        # review): from here it interrupts, as in the foreground (exit 130, no file)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         return args.func(args)
     except UsageError as exc:

@@ -494,3 +494,29 @@ def test_resume_and_overwrite_together_are_refused(tmp_path, scene_file, capsys)
     err = capsys.readouterr().err
     assert err == ("oceanmc: error: --resume and --overwrite together: --resume continues a "
                    "partial file, --overwrite replaces it with a new run; give one of them\n")
+
+
+def test_a_background_run_s_early_sigint_interrupts_it(tmp_path, scene_file, monkeypatch,
+                                                        capsys):
+    """A job a script starts in the background inherits SIGINT as ignored; before the run's own
+    handler took over (reading the scenes, building their tables), `kill -INT` was dropped and
+    the run finished with exit 0 (a user's review). Now it interrupts there too: exit 130, no
+    file."""
+    import signal
+
+    import oceanmc.config as config_module
+    from oceanmc import cli
+    original = config_module.load_config
+
+    def load_then_signal(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)    # what `kill -INT` does while the scene is read
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(config_module, "load_config", load_then_signal)
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        code = cli.main(["run", str(scene_file), "-o", str(tmp_path / "r.h5"), "-q"])
+    finally:
+        signal.signal(signal.SIGINT, before)
+    assert code == 130 and not (tmp_path / "r.h5").exists()
+    assert "interrupted; no partial results file was written" in capsys.readouterr().err
