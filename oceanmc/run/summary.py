@@ -132,16 +132,15 @@ def unbiased_local_nadir(result: Result) -> bool:
 def local_nadir_hint(result: Result) -> str:
     """What the crossing estimate's summary line adds: how to get the cap's local estimate, or
     why the scene cannot have it."""
-    import yaml
     from pydantic import TypeAdapter
 
     from ..config import Bottom, Surface, bottom_has_mirror
     from ..config.surface import MAX_CAP_MSS
     try:
-        scene = yaml.safe_load(result.config_yaml)
+        scene = stored_scene(result.config_yaml)
         surface = Surface(**scene["surface"])
         bottom = TypeAdapter(Bottom).validate_python(scene["bottom"])
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+    except (KeyError, TypeError, ValueError):
         return ""
     if bottom_has_mirror(bottom):
         return "; a mirror bottom has no density for the local estimate"
@@ -184,12 +183,11 @@ def stored_illumination(result: Result) -> dict | None:
     """The stored scene's illumination mapping, its sun_zenith_deg a float, and its spectrum's
     model as spectrum_model; None where the file does not say (an unreadable or older
     config)."""
-    import yaml
     try:
-        light = yaml.safe_load(result.config_yaml)["illumination"]
+        light = stored_scene(result.config_yaml)["illumination"]
         return dict(light, sun_zenith_deg=float(light["sun_zenith_deg"]),
                     spectrum_model=str(light["spectrum"]["model"]))
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+    except (KeyError, TypeError, ValueError):
         return None
 
 
@@ -244,12 +242,10 @@ def process_descriptions(result: Result) -> list[str]:
     """Each inelastic process of a run with its settings, as the stored scene has them (with
     the defaults filled in), so that a comparison (e.g. with HydroLight) can check them; the
     parts' names alone where the stored scene cannot be read."""
-    import yaml
-
     from ..config.inelastic import Inelastic
     try:
-        inelastic = Inelastic(**yaml.safe_load(result.config_yaml)["water"]["inelastic"])
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        inelastic = Inelastic(**stored_scene(result.config_yaml)["water"]["inelastic"])
+    except (KeyError, TypeError, ValueError):
         return [PART_LABELS.get(part, part) for part in light_parts(result)[1:]]
     said = []
     for name, process in inelastic.processes():
@@ -371,13 +367,24 @@ def format_spectrum(result: Result) -> list[str]:
 RELIABLE_BATCHES = 8
 
 
+def stored_scene(config_yaml: str) -> dict:
+    """The stored scene (attribute config_yaml) as a mapping, {} where the text is not a YAML
+    mapping (an unreadable or foreign file): what the summary's lines read it for is then
+    missing, as a key is."""
+    import yaml
+    try:
+        scene = yaml.safe_load(config_yaml)
+    except yaml.YAMLError:
+        return {}
+    return scene if isinstance(scene, dict) else {}
+
+
 def planned_batches(config_yaml: str) -> int | None:
     """The batches the stored scene asked for (a partial file holds fewer whole ones); None
     where the stored text does not say."""
-    import yaml
     try:
-        return int(yaml.safe_load(config_yaml)["batches"])
-    except (KeyError, TypeError, ValueError, yaml.YAMLError):
+        return int(stored_scene(config_yaml)["batches"])
+    except (KeyError, TypeError, ValueError):
         return None
 
 
@@ -404,15 +411,14 @@ def completeness_line(result: Result) -> str | None:
 def single_wavelength(result: Result) -> float | None:
     """The wavelength (nm) of a run that traced one, which its file holds no wavelength
     coordinate for; None for a monochromatic scene (no wavelength) or several."""
-    import yaml
     from pydantic import TypeAdapter
 
     from ..config.wavelengths import Wavelengths, grid
     try:
-        value = yaml.safe_load(result.config_yaml).get("wavelengths_nm")
+        value = stored_scene(result.config_yaml).get("wavelengths_nm")
         wavelengths = grid(None if value is None
                            else TypeAdapter(Wavelengths).validate_python(value))
-    except (AttributeError, KeyError, TypeError, ValueError, yaml.YAMLError):
+    except (KeyError, TypeError, ValueError):
         return None
     return float(wavelengths[0]) if len(wavelengths) == 1 and np.isfinite(wavelengths[0]) \
         else None
@@ -431,13 +437,12 @@ def data_file_lines(result: Result) -> list[str]:
         return []
     keys = {}
     try:   # (the keys that name them: a stored config loads without its files)
-        import yaml
         from ..config import ConfigError, load_config
         from ..config.loading import data_file_fields
-        config = load_config(yaml.safe_load(result.config_yaml))
+        config = load_config(stored_scene(result.config_yaml))
         keys = {getattr(model, attribute): key
                 for model, attribute, key in data_file_fields(config)}
-    except (ConfigError, yaml.YAMLError, TypeError, ValueError):
+    except (ConfigError, TypeError, ValueError):
         pass
     text = "data files (sha256 when run): " + "; ".join(
         (f"{keys[path]} = " if path in keys else "") + f"{path} ({digest[:12]})"
